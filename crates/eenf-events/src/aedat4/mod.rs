@@ -1,0 +1,515 @@
+//! iniVation AEDAT 4.0: reader and writer.
+//!
+//! Layout (see `docs/formats.md`): magic, u32 header length, IOHeader FlatBuffer, then packets
+//! `{i32 stream, i32 size, body}` whose bodies are compressed size-prefixed FlatBuffers, and an
+//! optional FileDataTable at the end.
+
+mod flatbuf;
+mod writer;
+
+use std::collections::VecDeque;
+use std::fs::File;
+use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+use crate::error::{io_err, EventError, Result};
+use crate::{EventBatch, EventReader, StreamDesc, StreamInfo};
+use flatbuf::Table;
+pub use writer::Aedat4Writer;
+
+/// The 14-byte magic that starts every AEDAT 4.0 file.
+pub const MAGIC: &[u8; 14] = b"#!AER-DAT4.0\r\n";
+const FORMAT: &str = "AEDAT 4.0";
+/// Largest header or packet body accepted: far above what any writer produces, and a guard
+/// against allocating from a corrupt size field.
+const MAX_CHUNK: u64 = 1 << 30;
+/// Bytes of one event in an EventPacket.
+const EVENT_SIZE: usize = 16;
+/// Packets decompressed together in parallel.
+const PACKETS_PER_ROUND: usize = 16;
+
+/// Packet compression of an AEDAT4 file (IOHeader field 0).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Compression {
+    /// Stored as is.
+    None,
+    /// LZ4 frame, fast mode.
+    Lz4,
+    /// LZ4 frame, high-compression mode.
+    Lz4High,
+    /// Zstandard frame, default level.
+    Zstd,
+    /// Zstandard frame, high level.
+    ZstdHigh,
+}
+
+impl Compression {
+    /// From the IOHeader's integer code.
+    pub fn from_code(code: i32) -> Option<Self> {
+        Some(match code {
+            0 => Compression::None,
+            1 => Compression::Lz4,
+            2 => Compression::Lz4High,
+            3 => Compression::Zstd,
+            4 => Compression::ZstdHigh,
+            _ => return None,
+        })
+    }
+
+    /// The IOHeader's integer code.
+    pub fn code(self) -> i32 {
+        match self {
+            Compression::None => 0,
+            Compression::Lz4 => 1,
+            Compression::Lz4High => 2,
+            Compression::Zstd => 3,
+            Compression::ZstdHigh => 4,
+        }
+    }
+
+    /// The name used by the DV software (`NONE`, `LZ4`, `LZ4_HIGH`, `ZSTD`, `ZSTD_HIGH`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Compression::None => "NONE",
+            Compression::Lz4 => "LZ4",
+            Compression::Lz4High => "LZ4_HIGH",
+            Compression::Zstd => "ZSTD",
+            Compression::ZstdHigh => "ZSTD_HIGH",
+        }
+    }
+
+    /// Parses a name as printed by [`Compression::name`] (case-insensitive, `-` or `_`).
+    pub fn parse(s: &str) -> Option<Self> {
+        let s = s.to_ascii_uppercase().replace('-', "_");
+        [
+            Compression::None,
+            Compression::Lz4,
+            Compression::Lz4High,
+            Compression::Zstd,
+            Compression::ZstdHigh,
+        ]
+        .into_iter()
+        .find(|c| c.name() == s)
+    }
+}
+
+/// Streams declared in the IOHeader's XML `infoNode`: (id, type identifier, width, height, source).
+fn parse_streams(xml: &str) -> Vec<StreamDesc> {
+    // A tolerant scan instead of an XML parser: nodes are entered and left, and each `attr`
+    // belongs to the innermost enclosing node whose name is a stream number. Node paths differ
+    // between writers, so they are not used.
+    let mut stack: Vec<Option<i32>> = Vec::new();
+    let mut streams: Vec<StreamDesc> = Vec::new();
+    let mut rest = xml;
+    while let Some(lt) = rest.find('<') {
+        rest = &rest[lt..];
+        let end = rest.find('>').unwrap_or(rest.len());
+        let tag = &rest[..end];
+        if tag.starts_with("</node") {
+            stack.pop();
+        } else if tag.starts_with("<node") {
+            let id = attr_value(tag, "name").and_then(|n| n.parse::<i32>().ok());
+            if !tag.ends_with('/') {
+                stack.push(id);
+            }
+        } else if tag.starts_with("<attr") {
+            let key = attr_value(tag, "key").unwrap_or_default();
+            let value_end = rest.find("</attr>").unwrap_or(end);
+            let value = rest.get(end + 1..value_end).unwrap_or("").trim();
+            if let Some(id) = stack.iter().rev().find_map(|s| *s) {
+                let idx = match streams.iter().position(|s| s.id == id) {
+                    Some(i) => i,
+                    None => {
+                        streams.push(StreamDesc {
+                            id,
+                            kind: String::new(),
+                            width: None,
+                            height: None,
+                            source: None,
+                        });
+                        streams.len() - 1
+                    }
+                };
+                let s = &mut streams[idx];
+                match key.as_str() {
+                    "typeIdentifier" => s.kind = value.to_string(),
+                    "sizeX" => s.width = value.parse().ok(),
+                    "sizeY" => s.height = value.parse().ok(),
+                    "source" => s.source = Some(value.to_string()),
+                    _ => {}
+                }
+            }
+        }
+        rest = &rest[end.min(rest.len())..];
+        if rest.len() <= 1 {
+            break;
+        }
+        rest = &rest[1..];
+    }
+    streams.sort_by_key(|s| s.id);
+    streams
+}
+
+fn attr_value(tag: &str, name: &str) -> Option<String> {
+    let key = format!("{name}=\"");
+    let start = tag.find(&key)? + key.len();
+    let len = tag[start..].find('"')?;
+    Some(tag[start..start + len].to_string())
+}
+
+/// Decompresses one packet body. The output size is bounded so that a corrupt frame cannot
+/// make us allocate without limit.
+fn decompress(codec: Compression, body: &[u8]) -> std::result::Result<Vec<u8>, String> {
+    let mut out = Vec::with_capacity(body.len() * 3);
+    let res = match codec {
+        Compression::None => return Ok(body.to_vec()),
+        Compression::Lz4 | Compression::Lz4High => lz4_flex::frame::FrameDecoder::new(body)
+            .take(MAX_CHUNK)
+            .read_to_end(&mut out),
+        Compression::Zstd | Compression::ZstdHigh => zstd::stream::read::Decoder::new(body)
+            .and_then(|d| d.take(MAX_CHUNK).read_to_end(&mut out)),
+    };
+    res.map_err(|e| format!("{} decompression failed: {e}", codec.name()))?;
+    Ok(out)
+}
+
+/// Decodes a decompressed packet body. `Ok(None)` when the packet is not an event packet.
+fn decode_event_packet(body: &[u8]) -> std::result::Result<Option<EventBatch>, String> {
+    if body.get(8..12) != Some(b"EVTS") {
+        return Ok(None);
+    }
+    let table = Table::size_prefixed_root(body, Some(b"EVTS")).map_err(|e| e.0)?;
+    let Some((n, bytes)) = table.struct_vector(0, EVENT_SIZE).map_err(|e| e.0)? else {
+        return Ok(Some(EventBatch::default()));
+    };
+    let mut batch = EventBatch::with_capacity(n);
+    // Column-wise conversion from the 16-byte records: t i64, x i16, y i16, on bool, 3 pad.
+    batch.t.extend(
+        bytes
+            .chunks_exact(EVENT_SIZE)
+            .map(|e| i64::from_le_bytes(e[0..8].try_into().unwrap())),
+    );
+    batch.x.extend(
+        bytes
+            .chunks_exact(EVENT_SIZE)
+            .map(|e| u16::from_le_bytes([e[8], e[9]])),
+    );
+    batch.y.extend(
+        bytes
+            .chunks_exact(EVENT_SIZE)
+            .map(|e| u16::from_le_bytes([e[10], e[11]])),
+    );
+    batch
+        .p
+        .extend(bytes.chunks_exact(EVENT_SIZE).map(|e| e[12] != 0));
+    Ok(Some(batch))
+}
+
+/// Summary of the FileDataTable for one stream.
+#[derive(Debug, Clone, Copy, Default)]
+struct TableSummary {
+    events: u64,
+    first_t: Option<i64>,
+    last_t: Option<i64>,
+}
+
+/// Reads an AEDAT 4.0 file packet by packet; memory is bounded by a few packets.
+pub struct Aedat4Reader {
+    path: PathBuf,
+    file: BufReader<File>,
+    pos: u64,
+    end: u64,
+    codec: Compression,
+    /// Stream ids whose packets may hold events (from the XML; empty = check every packet).
+    event_streams: Vec<i32>,
+    info: StreamInfo,
+    pending: VecDeque<EventBatch>,
+    failed: Option<EventError>,
+}
+
+impl Aedat4Reader {
+    /// Opens the file and reads its header (and FileDataTable, when present).
+    pub fn open(path: &Path) -> Result<Self> {
+        let file = File::open(path).map_err(|e| io_err(path, e))?;
+        let file_len = file.metadata().map_err(|e| io_err(path, e))?.len();
+        let mut file = BufReader::with_capacity(1 << 20, file);
+        let trunc = |offset: u64, reason: &str| EventError::Truncated {
+            path: path.to_path_buf(),
+            format: FORMAT,
+            offset,
+            reason: reason.to_string(),
+        };
+        let corrupt = |offset: u64, reason: String| EventError::Corrupt {
+            path: path.to_path_buf(),
+            format: FORMAT,
+            offset,
+            reason,
+        };
+        let mut head = [0u8; 18];
+        read_exact_or(&mut file, &mut head, path, || trunc(0, "file header"))?;
+        if &head[..14] != MAGIC {
+            return Err(corrupt(0, "missing #!AER-DAT4.0 magic".into()));
+        }
+        let hlen = u32::from_le_bytes(head[14..18].try_into().unwrap()) as u64;
+        if hlen > MAX_CHUNK || 18 + hlen > file_len {
+            return Err(trunc(18, &format!("IOHeader of {hlen} bytes")));
+        }
+        let mut header = vec![0u8; hlen as usize];
+        read_exact_or(&mut file, &mut header, path, || trunc(18, "IOHeader"))?;
+        let t = Table::root(&header, Some(b"IOHE")).map_err(|e| corrupt(18, e.0))?;
+        let code = t.i32_field(0, 0).map_err(|e| corrupt(18, e.0))?;
+        let codec = Compression::from_code(code)
+            .ok_or_else(|| corrupt(18, format!("unknown compression code {code}")))?;
+        let table_pos = t.i64_field(1, -1).map_err(|e| corrupt(18, e.0))?;
+        let xml = t.str_field(2).map_err(|e| corrupt(18, e.0))?.unwrap_or("");
+        let streams = parse_streams(xml);
+        let event_streams: Vec<i32> = streams
+            .iter()
+            .filter(|s| s.kind == "EVTS")
+            .map(|s| s.id)
+            .take(1)
+            .collect();
+        let data_start = 18 + hlen;
+        let has_table = table_pos >= data_start as i64 && (table_pos as u64) < file_len;
+        let end = if has_table {
+            table_pos as u64
+        } else {
+            file_len
+        };
+        let evs = streams.iter().find(|s| s.kind == "EVTS");
+        let mut info = StreamInfo {
+            format: FORMAT,
+            codec: Some(codec.name().to_string()),
+            width: evs.and_then(|s| s.width),
+            height: evs.and_then(|s| s.height),
+            streams: streams.clone(),
+            event_count: None,
+            first_t: None,
+            last_t: None,
+            indexed: false,
+        };
+        if has_table {
+            // A damaged table only costs the up-front summary; the packets are still readable.
+            if let Ok(summary) = read_table(
+                &mut file,
+                table_pos as u64,
+                file_len,
+                codec,
+                event_streams.first().copied().unwrap_or(0),
+            ) {
+                info.event_count = Some(summary.events);
+                info.first_t = summary.first_t;
+                info.last_t = summary.last_t;
+                info.indexed = true;
+            }
+            file.seek(SeekFrom::Start(data_start))
+                .map_err(|e| io_err(path, e))?;
+        }
+        Ok(Aedat4Reader {
+            path: path.to_path_buf(),
+            file,
+            pos: data_start,
+            end,
+            codec,
+            event_streams,
+            info,
+            pending: VecDeque::new(),
+            failed: None,
+        })
+    }
+
+    /// Reads the next round of event packets and decodes them in parallel.
+    fn fill(&mut self) -> Result<()> {
+        let mut raw: Vec<(u64, Vec<u8>)> = Vec::with_capacity(PACKETS_PER_ROUND);
+        let mut failure = None;
+        while raw.len() < PACKETS_PER_ROUND && self.pos < self.end {
+            let at = self.pos;
+            if self.end - at < 8 {
+                failure = Some(self.truncated(at, "packet header"));
+                break;
+            }
+            let mut hdr = [0u8; 8];
+            if let Err(e) = self.file.read_exact(&mut hdr) {
+                failure = Some(io_err(&self.path, e));
+                break;
+            }
+            let stream = i32::from_le_bytes(hdr[0..4].try_into().unwrap());
+            let size = i32::from_le_bytes(hdr[4..8].try_into().unwrap());
+            if size < 0 || size as u64 > MAX_CHUNK {
+                failure = Some(self.corrupt(at, format!("packet size {size}")));
+                break;
+            }
+            let size = size as u64;
+            if size > self.end - at - 8 {
+                failure = Some(self.truncated(
+                    at,
+                    &format!(
+                        "packet of {size} bytes, only {} bytes left",
+                        self.end - at - 8
+                    ),
+                ));
+                break;
+            }
+            self.pos = at + 8 + size;
+            let wanted = self.event_streams.is_empty() || self.event_streams.contains(&stream);
+            if wanted {
+                let mut body = vec![0u8; size as usize];
+                if let Err(e) = self.file.read_exact(&mut body) {
+                    failure = Some(io_err(&self.path, e));
+                    break;
+                }
+                raw.push((at, body));
+            } else if let Err(e) = self.file.seek_relative(size as i64) {
+                failure = Some(io_err(&self.path, e));
+                break;
+            }
+        }
+        let codec = self.codec;
+        let decoded: Vec<std::result::Result<Option<EventBatch>, (u64, String)>> = raw
+            .par_iter()
+            .map(|(at, body)| {
+                decompress(codec, body)
+                    .and_then(|d| decode_event_packet(&d))
+                    .map_err(|e| (*at, e))
+            })
+            .collect();
+        for d in decoded {
+            match d {
+                Ok(Some(b)) if !b.is_empty() => self.pending.push_back(b),
+                Ok(_) => {}
+                Err((at, reason)) => {
+                    // Deliver the events before the damage, then the error.
+                    self.failed = Some(self.corrupt(at, reason));
+                    self.pos = self.end;
+                    return Ok(());
+                }
+            }
+        }
+        if let Some(f) = failure {
+            self.failed = Some(f);
+            self.pos = self.end;
+        }
+        Ok(())
+    }
+
+    fn truncated(&self, offset: u64, reason: &str) -> EventError {
+        EventError::Truncated {
+            path: self.path.clone(),
+            format: FORMAT,
+            offset,
+            reason: reason.to_string(),
+        }
+    }
+
+    fn corrupt(&self, offset: u64, reason: String) -> EventError {
+        EventError::Corrupt {
+            path: self.path.clone(),
+            format: FORMAT,
+            offset,
+            reason,
+        }
+    }
+}
+
+fn read_exact_or(
+    file: &mut impl Read,
+    buf: &mut [u8],
+    path: &Path,
+    on_eof: impl FnOnce() -> EventError,
+) -> Result<()> {
+    match file.read_exact(buf) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => Err(on_eof()),
+        Err(e) => Err(io_err(path, e)),
+    }
+}
+
+fn read_table(
+    file: &mut BufReader<File>,
+    pos: u64,
+    file_len: u64,
+    codec: Compression,
+    stream: i32,
+) -> std::result::Result<TableSummary, String> {
+    let len = file_len - pos;
+    if len > MAX_CHUNK {
+        return Err("FileDataTable too large".into());
+    }
+    file.seek(SeekFrom::Start(pos)).map_err(|e| e.to_string())?;
+    let mut raw = vec![0u8; len as usize];
+    file.read_exact(&mut raw).map_err(|e| e.to_string())?;
+    let body = decompress(codec, &raw)?;
+    let t = Table::size_prefixed_root(&body, Some(b"FTAB")).map_err(|e| e.0)?;
+    let mut s = TableSummary::default();
+    for entry in t.table_vector(0).map_err(|e| e.0)? {
+        let header = entry.struct_field(1, 8).map_err(|e| e.0)?;
+        let sid = header
+            .map(|h| i32::from_le_bytes(h[0..4].try_into().unwrap()))
+            .unwrap_or(0);
+        if sid != stream {
+            continue;
+        }
+        s.events += entry.i64_field(2, 0).map_err(|e| e.0)?.max(0) as u64;
+        let t0 = entry.i64_field(3, 0).map_err(|e| e.0)?;
+        let t1 = entry.i64_field(4, 0).map_err(|e| e.0)?;
+        s.first_t = Some(s.first_t.map_or(t0, |v| v.min(t0)));
+        s.last_t = Some(s.last_t.map_or(t1, |v| v.max(t1)));
+    }
+    Ok(s)
+}
+
+impl EventReader for Aedat4Reader {
+    fn info(&self) -> &StreamInfo {
+        &self.info
+    }
+
+    fn next_batch(&mut self) -> Result<Option<EventBatch>> {
+        loop {
+            if let Some(b) = self.pending.pop_front() {
+                return Ok(Some(b));
+            }
+            if let Some(e) = self.failed.take() {
+                return Err(e);
+            }
+            if self.pos >= self.end {
+                return Ok(None);
+            }
+            self.fill()?;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_stream_list_from_dv_xml() {
+        let xml = r#"<dv version="2.0"><node name="outInfo" path="/x/">
+            <node name="0" path="/x/0/"><attr key="typeIdentifier" type="string">EVTS</attr>
+              <node name="info" path="/x/0/info/"><attr key="sizeX" type="int">640</attr>
+              <attr key="sizeY" type="int">480</attr><attr key="source" type="string">DVX</attr></node>
+            </node>
+            <node name="2" path="/x/2/"><attr key="typeIdentifier" type="string">IMUS</attr></node>
+            </node></dv>"#;
+        let s = parse_streams(xml);
+        assert_eq!(s.len(), 2);
+        assert_eq!((s[0].id, s[0].kind.as_str()), (0, "EVTS"));
+        assert_eq!((s[0].width, s[0].height), (Some(640), Some(480)));
+        assert_eq!(s[0].source.as_deref(), Some("DVX"));
+        assert_eq!((s[1].id, s[1].kind.as_str()), (2, "IMUS"));
+    }
+
+    #[test]
+    fn compression_names_round_trip() {
+        for code in 0..5 {
+            let c = Compression::from_code(code).unwrap();
+            assert_eq!(Compression::parse(c.name()), Some(c));
+            assert_eq!(c.code(), code);
+        }
+        assert_eq!(Compression::parse("lz4-high"), Some(Compression::Lz4High));
+        assert_eq!(Compression::from_code(7), None);
+    }
+}

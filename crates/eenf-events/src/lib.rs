@@ -1,0 +1,214 @@
+//! # eenf-events
+//!
+//! The event model of eenf and the readers and writers of event-camera files.
+//!
+//! Events come in [`EventBatch`]es (struct-of-arrays: `t` µs, `x`, `y`, polarity), streamed
+//! from the file with memory that does not grow with the recording. [`open`] looks at the
+//! file's content (not its name) and picks the reader.
+//!
+//! ```no_run
+//! let mut reader = eenf_events::open(std::path::Path::new("recording.aedat4"))?;
+//! println!("{} {:?}x{:?}", reader.info().format, reader.info().width, reader.info().height);
+//! let mut on = 0usize;
+//! while let Some(batch) = reader.next_batch()? {
+//!     on += batch.p.iter().filter(|&&p| p).count();
+//! }
+//! println!("{on} ON events");
+//! # Ok::<(), eenf_events::EventError>(())
+//! ```
+
+pub mod aedat4;
+mod batch;
+mod error;
+pub mod text;
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+pub use aedat4::{Aedat4Reader, Aedat4Writer, Compression};
+pub use batch::EventBatch;
+pub use error::{EventError, Result};
+pub use text::TextReader;
+
+/// The formats this version reads, for error messages.
+pub const SUPPORTED: &str = "AEDAT 4.0 (.aedat4), text (t x y p)";
+
+/// One data stream declared by a file (AEDAT4 files can carry events, frames, IMU, triggers).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct StreamDesc {
+    /// Stream id used in the packet headers.
+    pub id: i32,
+    /// Type identifier: `EVTS`, `FRME`, `IMUS`, `TRIG`.
+    pub kind: String,
+    /// Sensor width, when declared.
+    pub width: Option<u16>,
+    /// Sensor height, when declared.
+    pub height: Option<u16>,
+    /// Camera name, when declared.
+    pub source: Option<String>,
+}
+
+/// What a reader knows about a recording before reading its events.
+#[derive(Debug, Clone, Default)]
+pub struct StreamInfo {
+    /// Format name, e.g. `AEDAT 4.0`.
+    pub format: &'static str,
+    /// Packet compression, when the format has one.
+    pub codec: Option<String>,
+    /// Sensor width, when the header says.
+    pub width: Option<u16>,
+    /// Sensor height, when the header says.
+    pub height: Option<u16>,
+    /// Streams declared in the header.
+    pub streams: Vec<StreamDesc>,
+    /// Number of events, when known without reading them (AEDAT4 FileDataTable).
+    pub event_count: Option<u64>,
+    /// First timestamp (µs), when known up front.
+    pub first_t: Option<i64>,
+    /// Last timestamp (µs), when known up front.
+    pub last_t: Option<i64>,
+    /// True when the file carries an index (FileDataTable).
+    pub indexed: bool,
+}
+
+/// A source of event batches.
+pub trait EventReader: Send {
+    /// What the header said.
+    fn info(&self) -> &StreamInfo;
+    /// The next batch of events, `None` at the end. Events before damage are delivered before
+    /// the error that reports it.
+    fn next_batch(&mut self) -> Result<Option<EventBatch>>;
+}
+
+/// The formats eenf recognises by content.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// iniVation AEDAT 4.0.
+    Aedat4,
+    /// Plain text `t x y p`.
+    Text,
+}
+
+/// Decides the format from the first bytes of the file.
+pub fn probe(path: &Path) -> Result<Format> {
+    let mut f = std::fs::File::open(path).map_err(|e| error::io_err(path, e))?;
+    let mut head = vec![0u8; 4096];
+    let mut n = 0;
+    while n < head.len() {
+        match f.read(&mut head[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) => return Err(error::io_err(path, e)),
+        }
+    }
+    head.truncate(n);
+    let unknown = |reason: String| EventError::UnknownFormat {
+        path: path.to_path_buf(),
+        reason,
+        supported: SUPPORTED,
+    };
+    if n == 0 {
+        return Err(unknown("the file is empty".into()));
+    }
+    if head.starts_with(aedat4::MAGIC) {
+        return Ok(Format::Aedat4);
+    }
+    let later = |name: &str| unknown(format!("{name} is recognised but not readable yet"));
+    if head.starts_with(b"#!AER-DAT2.0") || head.starts_with(b"#!AER-DAT3") {
+        return Err(later("jAER AEDAT 2.0/3.x"));
+    }
+    if head.starts_with(b"% ") {
+        return Err(later("Prophesee RAW/DAT"));
+    }
+    // Text: the first event line (after comments) holds four numbers. Judge only complete lines.
+    let text = String::from_utf8_lossy(&head);
+    let complete = match text.rfind('\n') {
+        Some(i) if n == 4096 => &text[..i],
+        _ => &text[..],
+    };
+    if !head.contains(&0) {
+        let mut names_seen = false;
+        for line in complete.lines() {
+            let l = line.trim();
+            if l.is_empty() || l.starts_with('#') {
+                continue;
+            }
+            if !names_seen && text::is_column_names(l) {
+                names_seen = true;
+                continue;
+            }
+            if text::looks_like_event_line(l) {
+                return Ok(Format::Text);
+            }
+            break;
+        }
+    }
+    Err(unknown(format!(
+        "unrecognised content starting with {:?}",
+        String::from_utf8_lossy(&head[..n.min(16)])
+    )))
+}
+
+/// Opens an event file with the reader its content calls for.
+pub fn open(path: &Path) -> Result<Box<dyn EventReader>> {
+    Ok(match probe(path)? {
+        Format::Aedat4 => Box::new(Aedat4Reader::open(path)?),
+        Format::Text => Box::new(TextReader::open(path)?),
+    })
+}
+
+/// Counts and ranges of a whole stream, from reading it to the end.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct StreamStats {
+    /// Number of events.
+    pub events: u64,
+    /// ON events.
+    pub on: u64,
+    /// First timestamp (µs).
+    pub first_t: Option<i64>,
+    /// Last timestamp (µs).
+    pub last_t: Option<i64>,
+    /// Smallest and largest x.
+    pub x_range: Option<(u16, u16)>,
+    /// Smallest and largest y.
+    pub y_range: Option<(u16, u16)>,
+}
+
+impl StreamStats {
+    /// Adds a batch.
+    pub fn add(&mut self, b: &EventBatch) {
+        if b.is_empty() {
+            return;
+        }
+        self.events += b.len() as u64;
+        self.on += b.p.iter().filter(|&&p| p).count() as u64;
+        self.first_t.get_or_insert(b.t[0]);
+        self.last_t = Some(b.t[b.len() - 1]);
+        let range = |v: &[u16], r: &mut Option<(u16, u16)>| {
+            let lo = *v.iter().min().unwrap();
+            let hi = *v.iter().max().unwrap();
+            *r = Some(match *r {
+                Some((a, b)) => (a.min(lo), b.max(hi)),
+                None => (lo, hi),
+            });
+        };
+        range(&b.x, &mut self.x_range);
+        range(&b.y, &mut self.y_range);
+    }
+
+    /// Reads `reader` to the end.
+    pub fn scan(reader: &mut dyn EventReader) -> Result<Self> {
+        let mut s = StreamStats::default();
+        while let Some(b) = reader.next_batch()? {
+            s.add(&b);
+        }
+        Ok(s)
+    }
+}
+
+/// A temporary path beside `path`, for writing a file whole before renaming it into place.
+pub fn tmp_path_for(path: &Path) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(format!(".{}.tmp", std::process::id()));
+    path.with_file_name(name)
+}

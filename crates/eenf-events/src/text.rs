@@ -1,0 +1,238 @@
+//! Plain text events: one `t x y p` per line.
+//!
+//! No standard exists, so the reader is lenient: `#` comments, whitespace or comma separators,
+//! time in float seconds (rounded to the nearest microsecond) or integer microseconds,
+//! polarity 0/1 or -1/+1.
+
+use std::fs::File;
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+
+use crate::error::{io_err, EventError, Result};
+use crate::{EventBatch, EventReader, StreamInfo};
+
+const FORMAT: &str = "text";
+const BATCH: usize = 1 << 16;
+
+/// How the time column is written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TimeUnit {
+    Seconds,
+    Micros,
+}
+
+/// Splits a data line into fields; `None` for blank and comment lines.
+fn fields(line: &str) -> Option<impl Iterator<Item = &str>> {
+    let l = line.trim();
+    if l.is_empty() || l.starts_with('#') || l.starts_with('%') {
+        return None;
+    }
+    Some(
+        l.split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|s| !s.is_empty()),
+    )
+}
+
+/// True when `line` is a row of column names (no field is a number), such as `t_us,x,y,p`.
+pub(crate) fn is_column_names(line: &str) -> bool {
+    match fields(line) {
+        Some(f) => {
+            let v: Vec<&str> = f.collect();
+            (3..=5).contains(&v.len()) && v.iter().all(|s| s.parse::<f64>().is_err())
+        }
+        None => false,
+    }
+}
+
+/// True when `line` looks like an event line (four numbers).
+pub(crate) fn looks_like_event_line(line: &str) -> bool {
+    match fields(line) {
+        Some(f) => {
+            let v: Vec<&str> = f.collect();
+            v.len() == 4 && v.iter().all(|s| s.parse::<f64>().is_ok())
+        }
+        None => false,
+    }
+}
+
+fn parse_line(
+    line: &str,
+    unit: TimeUnit,
+) -> std::result::Result<Option<(i64, u16, u16, bool)>, String> {
+    let Some(mut f) = fields(line) else {
+        return Ok(None);
+    };
+    let mut next = |what: &str| f.next().ok_or_else(|| format!("missing {what} column"));
+    let t = next("time")?;
+    let x = next("x")?;
+    let y = next("y")?;
+    let p = next("polarity")?;
+    let t = match unit {
+        TimeUnit::Micros => match t.parse::<i64>() {
+            Ok(v) => v,
+            // A float in a file of integers: still microseconds.
+            Err(_) => t
+                .parse::<f64>()
+                .map_err(|_| format!("bad time {t:?}"))?
+                .round() as i64,
+        },
+        TimeUnit::Seconds => {
+            let s: f64 = t.parse().map_err(|_| format!("bad time {t:?}"))?;
+            (s * 1e6).round() as i64
+        }
+    };
+    let coord = |v: &str, what: &str| -> std::result::Result<u16, String> {
+        v.parse::<u16>()
+            .or_else(|_| {
+                v.parse::<f64>()
+                    .ok()
+                    .filter(|f| f.fract() == 0.0 && (0.0..=65535.0).contains(f))
+                    .map(|f| f as u16)
+                    .ok_or(())
+            })
+            .map_err(|_| format!("bad {what} {v:?}"))
+    };
+    let x = coord(x, "x")?;
+    let y = coord(y, "y")?;
+    let p: f64 = p.parse().map_err(|_| format!("bad polarity {p:?}"))?;
+    Ok(Some((t, x, y, p > 0.0)))
+}
+
+/// Streams events from a text file.
+pub struct TextReader {
+    path: PathBuf,
+    lines: std::io::Lines<BufReader<File>>,
+    line_no: u64,
+    unit: TimeUnit,
+    info: StreamInfo,
+    done: bool,
+    seen_data: bool,
+}
+
+impl TextReader {
+    /// Opens a text event file; the time unit is decided from the first event line.
+    pub fn open(path: &Path) -> Result<Self> {
+        let f = File::open(path).map_err(|e| io_err(path, e))?;
+        let mut unit = TimeUnit::Micros;
+        for line in BufReader::new(f).lines().take(10_000) {
+            let line = line.map_err(|e| io_err(path, e))?;
+            if is_column_names(&line) {
+                continue;
+            }
+            let first = fields(&line).map(|mut fs| fs.next().unwrap_or("").to_string());
+            if let Some(t) = first {
+                if t.contains(['.', 'e', 'E']) {
+                    unit = TimeUnit::Seconds;
+                }
+                break;
+            }
+        }
+        let f = File::open(path).map_err(|e| io_err(path, e))?;
+        Ok(TextReader {
+            path: path.to_path_buf(),
+            lines: BufReader::with_capacity(1 << 20, f).lines(),
+            line_no: 0,
+            unit,
+            info: StreamInfo {
+                format: FORMAT,
+                ..StreamInfo::default()
+            },
+            done: false,
+            seen_data: false,
+        })
+    }
+}
+
+impl EventReader for TextReader {
+    fn info(&self) -> &StreamInfo {
+        &self.info
+    }
+
+    fn next_batch(&mut self) -> Result<Option<EventBatch>> {
+        if self.done {
+            return Ok(None);
+        }
+        let mut batch = EventBatch::with_capacity(BATCH);
+        while batch.len() < BATCH {
+            let Some(line) = self.lines.next() else {
+                self.done = true;
+                break;
+            };
+            self.line_no += 1;
+            let line = line.map_err(|e| io_err(&self.path, e))?;
+            if !self.seen_data && is_column_names(&line) {
+                continue;
+            }
+            match parse_line(&line, self.unit) {
+                Ok(Some((t, x, y, p))) => {
+                    self.seen_data = true;
+                    batch.push(t, x, y, p)
+                }
+                Ok(None) => {}
+                Err(reason) => {
+                    self.done = true;
+                    return Err(EventError::Corrupt {
+                        path: self.path.clone(),
+                        format: FORMAT,
+                        offset: self.line_no,
+                        reason: format!("line {}: {reason}", self.line_no),
+                    });
+                }
+            }
+        }
+        Ok(if batch.is_empty() { None } else { Some(batch) })
+    }
+}
+
+/// Writes events as text, `t x y p` with integer microseconds and polarity 0/1.
+pub fn write_text(path: &Path, batches: impl IntoIterator<Item = EventBatch>) -> Result<u64> {
+    let tmp = crate::tmp_path_for(path);
+    let res = (|| -> std::io::Result<u64> {
+        let mut w = std::io::BufWriter::new(File::create(&tmp)?);
+        writeln!(w, "# t_us x y p")?;
+        let mut n = 0;
+        for b in batches {
+            for i in 0..b.len() {
+                writeln!(w, "{} {} {} {}", b.t[i], b.x[i], b.y[i], b.p[i] as u8)?;
+            }
+            n += b.len() as u64;
+        }
+        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        Ok(n)
+    })();
+    match res {
+        Ok(n) => {
+            std::fs::rename(&tmp, path).map_err(|e| io_err(path, e))?;
+            Ok(n)
+        }
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(io_err(path, e))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_the_accepted_spellings() {
+        assert_eq!(
+            parse_line("0.000001500000 3 4 1", TimeUnit::Seconds).unwrap(),
+            Some((2, 3, 4, true))
+        );
+        assert_eq!(
+            parse_line("12, 3, 4, -1", TimeUnit::Micros).unwrap(),
+            Some((12, 3, 4, false))
+        );
+        assert_eq!(parse_line("# comment", TimeUnit::Micros).unwrap(), None);
+        assert!(parse_line("1 2 3", TimeUnit::Micros).is_err());
+        assert!(parse_line("1 2 x 3", TimeUnit::Micros).is_err());
+        // 0.0000015 s is 1.5 us: rounds (not truncates) to 2
+        assert_eq!(
+            parse_line("1.5e-6 0 0 0", TimeUnit::Seconds).unwrap(),
+            Some((2, 0, 0, false))
+        );
+    }
+}

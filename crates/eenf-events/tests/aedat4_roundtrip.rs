@@ -1,0 +1,206 @@
+//! Writer → reader round trips and damaged files, on data made here (no shared files needed).
+
+use eenf_events::{open, Aedat4Writer, Compression, EventBatch, EventError, StreamStats};
+use std::io::Write;
+
+fn sample(n: usize) -> EventBatch {
+    let mut b = EventBatch::default();
+    let mut state = 12345u64;
+    let mut t = 1_700_000_000_000_000i64;
+    for i in 0..n {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        if i % 3 == 0 {
+            t += (state >> 60) as i64; // several events share a timestamp
+        }
+        b.push(
+            t,
+            (state >> 20) as u16 % 640,
+            (state >> 40) as u16 % 480,
+            state >> 63 == 1,
+        );
+    }
+    b
+}
+
+fn read_all(path: &std::path::Path) -> EventBatch {
+    let mut r = open(path).unwrap();
+    let mut all = EventBatch::default();
+    while let Some(b) = r.next_batch().unwrap() {
+        all.extend_from(&b);
+    }
+    all
+}
+
+fn write(path: &std::path::Path, codec: Compression, events: &EventBatch) {
+    let mut w = Aedat4Writer::create(path, codec, 640, 480)
+        .unwrap()
+        .with_packet_events(1000);
+    // uneven slices, to exercise packet assembly across writes
+    let mut start = 0;
+    for len in [1usize, 999, 7_000, 13_337, 100_000] {
+        let end = (start + len).min(events.len());
+        let mut part = EventBatch::default();
+        part.t.extend_from_slice(&events.t[start..end]);
+        part.x.extend_from_slice(&events.x[start..end]);
+        part.y.extend_from_slice(&events.y[start..end]);
+        part.p.extend_from_slice(&events.p[start..end]);
+        w.write(&part).unwrap();
+        start = end;
+    }
+    assert_eq!(w.finish().unwrap(), events.len() as u64);
+}
+
+#[test]
+fn every_codec_round_trips_exactly_with_index() {
+    let dir = tempfile::tempdir().unwrap();
+    let events = sample(25_000);
+    for code in 0..5 {
+        let codec = Compression::from_code(code).unwrap();
+        let path = dir.path().join(format!("rt_{code}.aedat4"));
+        write(&path, codec, &events);
+        let r = open(&path).unwrap();
+        let info = r.info().clone();
+        assert_eq!(info.format, "AEDAT 4.0");
+        assert_eq!(info.codec.as_deref(), Some(codec.name()));
+        assert_eq!((info.width, info.height), (Some(640), Some(480)));
+        assert!(info.indexed, "FileDataTable read back");
+        assert_eq!(info.event_count, Some(25_000));
+        assert_eq!(info.first_t, Some(events.t[0]));
+        assert_eq!(info.last_t, Some(*events.t.last().unwrap()));
+        assert_eq!(read_all(&path), events, "codec {}", codec.name());
+    }
+    // nothing but the finished files is left behind
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 5);
+}
+
+fn expect_err(path: &std::path::Path) -> EventError {
+    let mut r = match open(path) {
+        Ok(r) => r,
+        Err(e) => return e,
+    };
+    loop {
+        match r.next_batch() {
+            Ok(Some(_)) => {}
+            Ok(None) => panic!("{} read without error", path.display()),
+            Err(e) => return e,
+        }
+    }
+}
+
+#[test]
+fn truncated_and_corrupt_files_are_errors_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let events = sample(20_000);
+    let good = dir.path().join("good.aedat4");
+    write(&good, Compression::Lz4, &events);
+    let bytes = std::fs::read(&good).unwrap();
+
+    // cut in the middle of the third packet
+    let cut = dir.path().join("cut.aedat4");
+    let mut pos = 18 + u32::from_le_bytes(bytes[14..18].try_into().unwrap()) as usize;
+    for _ in 0..2 {
+        pos += 8 + i32::from_le_bytes(bytes[pos + 4..pos + 8].try_into().unwrap()) as usize;
+    }
+    std::fs::write(&cut, &bytes[..pos + 30]).unwrap();
+    let e = expect_err(&cut);
+    assert!(matches!(e, EventError::Truncated { .. }), "{e}");
+    assert!(e.to_string().contains("cut.aedat4"), "{e}");
+    // the events before the damage are still delivered
+    let mut r = open(&cut).unwrap();
+    let first = r.next_batch().unwrap().unwrap();
+    assert_eq!(first.t[..10], events.t[..10]);
+
+    // flip bytes inside the compressed body of the second packet
+    let bad = dir.path().join("bad.aedat4");
+    let mut b2 = bytes.clone();
+    let p0 = 18 + u32::from_le_bytes(bytes[14..18].try_into().unwrap()) as usize;
+    let p1 = p0 + 8 + i32::from_le_bytes(bytes[p0 + 4..p0 + 8].try_into().unwrap()) as usize;
+    for k in 0..64 {
+        b2[p1 + 20 + k] ^= 0x5a;
+    }
+    std::fs::write(&bad, &b2).unwrap();
+    let e = expect_err(&bad);
+    assert!(matches!(e, EventError::Corrupt { .. }), "{e}");
+    assert!(e.to_string().contains("bad.aedat4"), "{e}");
+
+    // header only, cut inside the IOHeader, and a non-event file
+    let short = dir.path().join("short.aedat4");
+    std::fs::write(&short, &bytes[..40]).unwrap();
+    assert!(matches!(expect_err(&short), EventError::Truncated { .. }));
+    let junk = dir.path().join("junk.bin");
+    std::fs::File::create(&junk)
+        .unwrap()
+        .write_all(&[0u8, 1, 2, 3, 200, 100])
+        .unwrap();
+    let e = expect_err(&junk);
+    assert!(matches!(e, EventError::UnknownFormat { .. }), "{e}");
+    let empty = dir.path().join("empty.aedat4");
+    std::fs::write(&empty, b"").unwrap();
+    assert!(expect_err(&empty).to_string().contains("empty"));
+    let missing = dir.path().join("missing.aedat4");
+    assert!(matches!(expect_err(&missing), EventError::Io { .. }));
+}
+
+#[test]
+fn a_file_without_data_table_reads_to_the_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let events = sample(5_000);
+    let path = dir.path().join("t.aedat4");
+    write(&path, Compression::Zstd, &events);
+    // Drop the table and set the header's dataTablePosition to -1, as an interrupted recording
+    // leaves the file.
+    let mut bytes = std::fs::read(&path).unwrap();
+    let info = open(&path).unwrap().info().clone();
+    assert!(info.indexed);
+    let hlen = u32::from_le_bytes(bytes[14..18].try_into().unwrap()) as usize;
+    let table_pos = find_table_pos(&bytes, hlen);
+    bytes.truncate(table_pos as usize);
+    let needle = table_pos.to_le_bytes();
+    let at = bytes[18..18 + hlen]
+        .windows(8)
+        .position(|w| w == needle)
+        .unwrap();
+    bytes[18 + at..18 + at + 8].copy_from_slice(&(-1i64).to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let r = open(&path).unwrap();
+    assert!(!r.info().indexed);
+    assert_eq!(r.info().event_count, None);
+    assert_eq!(read_all(&path), events);
+    let mut r = open(&path).unwrap();
+    let stats = StreamStats::scan(r.as_mut()).unwrap();
+    assert_eq!(stats.events, 5_000);
+}
+
+fn find_table_pos(bytes: &[u8], hlen: usize) -> i64 {
+    // walk packets until the remaining bytes are not a packet of the event stream
+    let mut pos = 18 + hlen;
+    loop {
+        let size = i32::from_le_bytes(bytes[pos + 4..pos + 8].try_into().unwrap()) as usize;
+        let next = pos + 8 + size;
+        if next >= bytes.len() || i32::from_le_bytes(bytes[pos..pos + 4].try_into().unwrap()) != 0 {
+            return pos as i64;
+        }
+        pos = next;
+    }
+}
+
+#[test]
+fn text_files_read_both_time_spellings() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.txt");
+    std::fs::write(&a, "# t x y p\n0.000001 1 2 1\n0.0000026 3 4 0\n").unwrap();
+    let e = read_all(&a);
+    assert_eq!(e.t, vec![1, 3]); // 2.6 us rounds to 3, not truncated to 2
+    assert_eq!(e.p, vec![true, false]);
+    let b = dir.path().join("b.csv");
+    std::fs::write(&b, "t_us,x,y,p\n10,1,2,-1\n11,3,4,1\n").unwrap();
+    let e = read_all(&b);
+    assert_eq!(e.t, vec![10, 11]);
+    assert_eq!(e.p, vec![false, true]);
+    let c = dir.path().join("c.txt");
+    std::fs::write(&c, "1 2 3 1\n2 2 3 1\nbroken line here\n").unwrap();
+    let err = expect_err(&c);
+    assert!(err.to_string().contains("line 3"), "{err}");
+}
