@@ -1,1 +1,36 @@
-//! placeholder
+//! # eenf-dsp
+//!
+//! The signal processing of eenf, free of I/O: the temporal sampler that turns events into a
+//! polarity sequence, zero-phase Butterworth band-passes (scipy-compatible), the centred STFT
+//! peak tracker with two peak refinements, outlier correction, harmonic selection, and the
+//! metrics that compare traces. `docs/method.md` (in the shared folder) explains every step.
+//!
+//! ```
+//! use eenf_dsp::{reference_enf, EnfParams, PeakMethod};
+//! // 40 s of a 50.01 Hz tone sampled at 400 Hz
+//! let fs = 400.0;
+//! let x: Vec<f64> = (0..16_000)
+//!     .map(|i| (2.0 * std::f64::consts::PI * 50.01 * i as f64 / fs).cos())
+//!     .collect();
+//! let trace = reference_enf(&x, fs, &EnfParams::default()).unwrap();
+//! assert_eq!(trace.len(), 41);
+//! assert!((trace[20] - 50.01).abs() < 1e-5);
+//! ```
+
+pub mod butter;
+pub mod enf;
+pub mod filtfilt;
+pub mod metrics;
+pub mod postprocess;
+pub mod sampling;
+pub mod tracker;
+
+pub use butter::{butter_bandpass, sos_to_ba, Section};
+pub use enf::{
+    check_line, detect_nominal, enf_from_flicker, extract_enf, line_prominence, reference_enf,
+    DspError, EnfParams, EnfTrace, HarmonicTrace,
+};
+pub use filtfilt::sosfiltfilt;
+pub use metrics::{agreement, Agreement};
+pub use sampling::{PolaritySequence, SamplingError, SamplingMethod, TemporalSampler};
+pub use tracker::{PeakMethod, StftTracker};

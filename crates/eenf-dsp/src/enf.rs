@@ -1,0 +1,281 @@
+//! The E-ENF pipeline on a sampled flicker signal, and the reference tracker for mains signals.
+
+use rayon::prelude::*;
+use realfft::RealFftPlanner;
+
+use crate::butter::butter_bandpass;
+use crate::filtfilt::sosfiltfilt;
+use crate::postprocess::{median_correct, select_smoothest};
+use crate::sampling::{PolaritySequence, SamplingError};
+use crate::tracker::{PeakMethod, StftTracker};
+
+/// Every parameter of the method, with the paper's defaults (except the peak refinement).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct EnfParams {
+    /// Nominal grid frequency f0, Hz (50 or 60).
+    pub nominal_hz: f64,
+    /// Number of flicker harmonics M (2m·f0 for m = 1..M; those at or above Nyquist skipped).
+    pub harmonics: usize,
+    /// Half width of each band-pass, Hz.
+    pub half_band_hz: f64,
+    /// Butterworth order of the band-pass prototype.
+    pub filter_order: usize,
+    /// STFT window, s.
+    pub window_s: f64,
+    /// STFT step, s.
+    pub step_s: f64,
+    /// Peak refinement.
+    pub peak: PeakMethod,
+    /// Bin width of the `paper` refinement, Hz.
+    pub paper_bin_hz: f64,
+    /// Running-median length of the outlier correction (0 disables it).
+    pub median_len: usize,
+    /// Outlier threshold on the 2f0 scale, Hz.
+    pub median_threshold_hz: f64,
+    /// Harmonic-selection segment length, in estimates (T = 10 s at 1 s steps).
+    pub segment_len: usize,
+}
+
+impl Default for EnfParams {
+    fn default() -> Self {
+        EnfParams {
+            nominal_hz: 50.0,
+            harmonics: 4,
+            half_band_hz: 2.0,
+            filter_order: 4,
+            window_s: 16.0,
+            step_s: 1.0,
+            peak: PeakMethod::Exact,
+            paper_bin_hz: 0.005,
+            median_len: 21,
+            median_threshold_hz: 0.02,
+            segment_len: 10,
+        }
+    }
+}
+
+impl EnfParams {
+    fn tracker(&self, fs: f64) -> StftTracker {
+        StftTracker {
+            fs,
+            window_s: self.window_s,
+            step_s: self.step_s,
+            peak: self.peak,
+            paper_bin_hz: self.paper_bin_hz,
+        }
+    }
+}
+
+/// Why a trace could not be made.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum DspError {
+    /// Less data than one STFT window.
+    #[error(
+        "the recording lasts {duration_s:.2} s, shorter than one {window_s} s analysis window"
+    )]
+    TooShort {
+        /// Duration of the input, s.
+        duration_s: f64,
+        /// Window length, s.
+        window_s: f64,
+    },
+    /// No harmonic band fits below Nyquist.
+    #[error(
+        "no flicker harmonic of {nominal_hz} Hz fits below the Nyquist frequency {nyquist_hz} Hz"
+    )]
+    NoHarmonic {
+        /// Nominal frequency, Hz.
+        nominal_hz: f64,
+        /// fs/2, Hz.
+        nyquist_hz: f64,
+    },
+    /// The input has no usable tone.
+    #[error("{0}")]
+    NoTone(String),
+    /// The sampler refused the events.
+    #[error(transparent)]
+    Sampling(#[from] SamplingError),
+}
+
+/// The ENF traced on one flicker harmonic.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct HarmonicTrace {
+    /// Harmonic number m: the band is centred on 2m·f0.
+    pub harmonic: usize,
+    /// Band centre, Hz.
+    pub center_hz: f64,
+    /// ENF estimates (divided by 2m), after outlier correction.
+    pub enf_hz: Vec<f64>,
+}
+
+/// An ENF trace and how it was assembled.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct EnfTrace {
+    /// Seconds between estimates; estimate i is centred at i·step_s from the start.
+    pub step_s: f64,
+    /// The ENF, Hz.
+    pub enf_hz: Vec<f64>,
+    /// Per-harmonic traces.
+    pub harmonics: Vec<HarmonicTrace>,
+    /// Harmonic number chosen in each segment.
+    pub selected: Vec<usize>,
+    /// Segment length of the selection, in estimates.
+    pub segment_len: usize,
+}
+
+/// E-ENF from a polarity sequence (the output of the temporal sampler).
+pub fn extract_enf(seq: &PolaritySequence, p: &EnfParams) -> Result<EnfTrace, DspError> {
+    let x: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
+    enf_from_flicker(&x, seq.fs(), p)
+}
+
+/// The ENF from any signal that flickers at 2·f_e and its harmonics, sampled at `fs`.
+pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfTrace, DspError> {
+    let duration_s = x.len() as f64 / fs;
+    if duration_s < p.window_s {
+        return Err(DspError::TooShort {
+            duration_s,
+            window_s: p.window_s,
+        });
+    }
+    let nyquist = fs / 2.0;
+    let bands: Vec<usize> = (1..=p.harmonics)
+        .filter(|m| 2.0 * *m as f64 * p.nominal_hz + p.half_band_hz < nyquist)
+        .collect();
+    if bands.is_empty() {
+        return Err(DspError::NoHarmonic {
+            nominal_hz: p.nominal_hz,
+            nyquist_hz: nyquist,
+        });
+    }
+    let tracker = p.tracker(fs);
+    let harmonics: Vec<HarmonicTrace> = bands
+        .par_iter()
+        .map(|&m| {
+            let center = 2.0 * m as f64 * p.nominal_hz;
+            let band = (center - p.half_band_hz, center + p.half_band_hz);
+            let sos = butter_bandpass(p.filter_order, band.0, band.1, fs);
+            let y = sosfiltfilt(&sos, x);
+            let raw = tracker.track(&y, band);
+            // correct outliers on the 2f0 scale, report on the f_e scale
+            let on_2f0: Vec<f64> = raw.iter().map(|f| f / m as f64).collect();
+            let corrected = if p.median_len > 1 {
+                median_correct(&on_2f0, p.median_len, p.median_threshold_hz)
+            } else {
+                on_2f0
+            };
+            HarmonicTrace {
+                harmonic: m,
+                center_hz: center,
+                enf_hz: corrected.iter().map(|f| f / 2.0).collect(),
+            }
+        })
+        .collect();
+    let traces: Vec<Vec<f64>> = harmonics.iter().map(|h| h.enf_hz.clone()).collect();
+    let (enf_hz, chosen) = select_smoothest(&traces, p.segment_len);
+    if enf_hz.iter().all(|v| !v.is_finite()) {
+        return Err(DspError::NoTone("the flicker bands hold no signal".into()));
+    }
+    Ok(EnfTrace {
+        step_s: p.step_s,
+        enf_hz,
+        selected: chosen.iter().map(|&i| harmonics[i].harmonic).collect(),
+        harmonics,
+        segment_len: p.segment_len,
+    })
+}
+
+/// The reference ENF of a mains (or audio) signal: the same tracker at the fundamental f0,
+/// searched within f0 ± `half_band_hz`. No filtering, as in the method's definition.
+pub fn reference_enf(x: &[f64], fs: f64, p: &EnfParams) -> Result<Vec<f64>, DspError> {
+    let duration_s = x.len() as f64 / fs;
+    if duration_s < p.window_s {
+        return Err(DspError::TooShort {
+            duration_s,
+            window_s: p.window_s,
+        });
+    }
+    if p.nominal_hz + p.half_band_hz >= fs / 2.0 {
+        return Err(DspError::NoHarmonic {
+            nominal_hz: p.nominal_hz,
+            nyquist_hz: fs / 2.0,
+        });
+    }
+    let band = (p.nominal_hz - p.half_band_hz, p.nominal_hz + p.half_band_hz);
+    Ok(p.tracker(fs).track(x, band))
+}
+
+/// How far a spectral line at `target` Hz stands above the spectrum around it (ratio of the
+/// peak magnitude within ±1 Hz to the median magnitude in 1.5–6 Hz either side). Uses at most
+/// the first 64 s.
+pub fn line_prominence(x: &[f64], fs: f64, target: f64) -> f64 {
+    let len = x.len().min((64.0 * fs) as usize);
+    if len < 16 || target + 6.0 >= fs / 2.0 {
+        return 0.0;
+    }
+    let nfft = len.next_power_of_two();
+    let fft = RealFftPlanner::<f64>::new().plan_fft_forward(nfft);
+    let mut input = fft.make_input_vec();
+    let mean = x[..len].iter().sum::<f64>() / len as f64;
+    for (d, s) in input.iter_mut().zip(&x[..len]) {
+        *d = s - mean;
+    }
+    let mut spec = fft.make_output_vec();
+    if fft.process(&mut input, &mut spec).is_err() {
+        return 0.0;
+    }
+    let df = fs / nfft as f64;
+    let bin = |f: f64| ((f / df).round() as usize).min(spec.len() - 1);
+    let peak = spec[bin(target - 1.0)..=bin(target + 1.0)]
+        .iter()
+        .map(|c| c.norm())
+        .fold(0.0, f64::max);
+    let mut around: Vec<f64> = spec[bin(target - 6.0)..=bin(target - 1.5)]
+        .iter()
+        .chain(&spec[bin(target + 1.5)..=bin(target + 6.0)])
+        .map(|c| c.norm())
+        .collect();
+    around.sort_by(|a, b| a.total_cmp(b));
+    let median = around.get(around.len() / 2).copied().unwrap_or(0.0);
+    if median > 0.0 {
+        peak / median
+    } else if peak > 0.0 {
+        f64::INFINITY
+    } else {
+        0.0
+    }
+}
+
+/// A line must stand this many times above its surroundings to count as a mains tone.
+pub const MIN_PROMINENCE: f64 = 8.0;
+
+/// Decides between a 50 Hz and a 60 Hz grid from the line at `multiple`·f0 (1 for mains
+/// recordings, 2 for light flicker). Errors when neither line stands out.
+pub fn detect_nominal(x: &[f64], fs: f64, multiple: f64) -> Result<f64, DspError> {
+    let p50 = line_prominence(x, fs, 50.0 * multiple);
+    let p60 = line_prominence(x, fs, 60.0 * multiple);
+    let (best, prom) = if p50 >= p60 { (50.0, p50) } else { (60.0, p60) };
+    if prom < MIN_PROMINENCE {
+        return Err(DspError::NoTone(format!(
+            "no mains line at {} or {} Hz (strongest stands {:.1}x above the noise, {MIN_PROMINENCE}x needed)",
+            50.0 * multiple,
+            60.0 * multiple,
+            prom
+        )));
+    }
+    Ok(best)
+}
+
+/// Checks that the line at `multiple`·`nominal` stands out; errors otherwise.
+pub fn check_line(x: &[f64], fs: f64, nominal: f64, multiple: f64) -> Result<(), DspError> {
+    let prom = line_prominence(x, fs, nominal * multiple);
+    if prom < MIN_PROMINENCE {
+        return Err(DspError::NoTone(format!(
+            "no {} Hz mains line ({} Hz grid): it stands only {:.1}x above the noise, {MIN_PROMINENCE}x needed",
+            nominal * multiple,
+            nominal,
+            prom
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,74 @@
+//! Agreement between an estimated ENF trace and a reference.
+
+/// Metrics over the seconds both traces cover.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Agreement {
+    /// Pearson correlation coefficient.
+    pub cc: f64,
+    /// Mean absolute error, Hz.
+    pub mae_hz: f64,
+    /// Root-mean-square error, Hz.
+    pub rmse_hz: f64,
+    /// Largest absolute error, Hz.
+    pub max_err_hz: f64,
+    /// Number of estimates compared.
+    pub n: usize,
+}
+
+/// Pearson CC, MAE, RMSE and max error of `est` against `reference` (pairs with a non-finite
+/// value are left out). `None` when fewer than two pairs remain.
+pub fn agreement(est: &[f64], reference: &[f64]) -> Option<Agreement> {
+    let pairs: Vec<(f64, f64)> = est
+        .iter()
+        .zip(reference)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(a, b)| (*a, *b))
+        .collect();
+    let n = pairs.len();
+    if n < 2 {
+        return None;
+    }
+    let nf = n as f64;
+    let (ma, mb) = pairs
+        .iter()
+        .fold((0.0, 0.0), |s, p| (s.0 + p.0 / nf, s.1 + p.1 / nf));
+    let (mut sab, mut saa, mut sbb, mut abs, mut sq, mut max) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0f64);
+    for &(a, b) in &pairs {
+        let (da, db) = (a - ma, b - mb);
+        sab += da * db;
+        saa += da * da;
+        sbb += db * db;
+        let e = (a - b).abs();
+        abs += e;
+        sq += e * e;
+        max = max.max(e);
+    }
+    let den = (saa * sbb).sqrt();
+    Some(Agreement {
+        cc: if den > 0.0 { sab / den } else { f64::NAN },
+        mae_hz: abs / nf,
+        rmse_hz: (sq / nf).sqrt(),
+        max_err_hz: max,
+        n,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn known_values() {
+        let a = [1.0, 2.0, 3.0, 4.0];
+        let b = [2.0, 4.0, 6.0, 8.0];
+        let m = agreement(&a, &b).unwrap();
+        assert!((m.cc - 1.0).abs() < 1e-12);
+        assert!((m.mae_hz - 2.5).abs() < 1e-12);
+        assert!((m.rmse_hz - 7.5f64.sqrt()).abs() < 1e-12);
+        assert_eq!(m.max_err_hz, 4.0);
+        let m = agreement(&a, &[4.0, 3.0, 2.0, f64::NAN]).unwrap();
+        assert!((m.cc + 1.0).abs() < 1e-12);
+        assert_eq!(m.n, 3);
+        assert!(agreement(&[1.0], &[1.0]).is_none());
+    }
+}

@@ -1,0 +1,335 @@
+//! Uniform-interval temporal sampling of an event stream into a polarity sequence
+//! E(n) ∈ {−1, 0, +1} (majority vote of the polarities in each sample).
+
+use eenf_events::EventBatch;
+
+/// How events are chosen for sample n (t_n = t_1 + n·Δt). See `docs/method.md`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SamplingMethod {
+    /// The paper: the events at the smallest timestamp ≥ t_n (the nearest future group).
+    Paper,
+    /// The authors' first code: the group at the largest timestamp in [t_n, t_n + Δt);
+    /// when that interval is empty the previous sample is repeated.
+    Authors,
+    /// The journal version: vote over all events in [t_n, t_n + Δt).
+    Block,
+}
+
+impl SamplingMethod {
+    /// Name as used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplingMethod::Paper => "paper",
+            SamplingMethod::Authors => "authors",
+            SamplingMethod::Block => "block",
+        }
+    }
+}
+
+/// The sampled polarity sequence.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PolaritySequence {
+    /// Time of sample 0 (the first event), µs.
+    pub t0_us: i64,
+    /// Sampling interval, µs.
+    pub dt_us: i64,
+    /// E(n) ∈ {−1, 0, +1}.
+    pub values: Vec<i8>,
+}
+
+impl PolaritySequence {
+    /// Sampling rate in Hz.
+    pub fn fs(&self) -> f64 {
+        1e6 / self.dt_us as f64
+    }
+
+    /// Duration covered, in seconds.
+    pub fn duration_s(&self) -> f64 {
+        self.values.len() as f64 * self.dt_us as f64 * 1e-6
+    }
+}
+
+/// A timestamp far outside the recording (a corrupt file) would ask for an unbounded sequence.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("event timestamp {t_us} µs is {span_s:.0} s after the first event, beyond the {limit_s:.0} s limit")]
+pub struct SamplingError {
+    /// The offending timestamp.
+    pub t_us: i64,
+    /// Its distance from the first event, s.
+    pub span_s: f64,
+    /// The limit, s.
+    pub limit_s: f64,
+}
+
+const EMPTY: i8 = i8::MIN;
+
+/// Turns event batches into a polarity sequence, one batch at a time.
+pub struct TemporalSampler {
+    method: SamplingMethod,
+    dt: i64,
+    t0: Option<i64>,
+    values: Vec<i8>,
+    /// Paper: the group at the end of the last batch, which may continue in the next one.
+    carry: Option<(i64, i64)>,
+    /// Block: ON − OFF per bin; Authors: the current group's (time, bin, ON − OFF).
+    counts: Vec<i32>,
+    group: Option<(i64, usize, i64)>,
+    max_samples: usize,
+    events: u64,
+}
+
+fn sign(v: i64) -> i8 {
+    v.signum() as i8
+}
+
+impl TemporalSampler {
+    /// A sampler with interval `dt_us` (1000 for the paper's 1 ms).
+    pub fn new(method: SamplingMethod, dt_us: i64) -> Self {
+        assert!(dt_us > 0, "sampling interval must be positive");
+        TemporalSampler {
+            method,
+            dt: dt_us,
+            t0: None,
+            values: Vec::new(),
+            carry: None,
+            counts: Vec::new(),
+            group: None,
+            max_samples: (48 * 3600 * 1_000_000 / dt_us) as usize,
+            events: 0,
+        }
+    }
+
+    /// Events seen so far.
+    pub fn events(&self) -> u64 {
+        self.events
+    }
+
+    fn check_bin(&self, t: i64, n: usize) -> Result<(), SamplingError> {
+        if n >= self.max_samples {
+            return Err(SamplingError {
+                t_us: t,
+                span_s: (t - self.t0.unwrap_or(t)) as f64 * 1e-6,
+                limit_s: self.max_samples as f64 * self.dt as f64 * 1e-6,
+            });
+        }
+        Ok(())
+    }
+
+    /// Adds a batch (events in time order, continuing the previous batch).
+    pub fn push(&mut self, batch: &EventBatch) -> Result<(), SamplingError> {
+        if batch.is_empty() {
+            return Ok(());
+        }
+        self.events += batch.len() as u64;
+        let t0 = *self.t0.get_or_insert(batch.t[0]);
+        match self.method {
+            SamplingMethod::Paper => self.push_paper(batch, t0),
+            SamplingMethod::Authors => self.push_authors(batch, t0),
+            SamplingMethod::Block => self.push_block(batch, t0),
+        }
+    }
+
+    /// Emits `vote` for every sample n with t_n ≤ t.
+    fn emit_upto(&mut self, t: i64, vote: i8, t0: i64) -> Result<(), SamplingError> {
+        let last_n = ((t - t0).max(0) / self.dt) as usize;
+        self.check_bin(t, last_n)?;
+        if self.values.len() <= last_n {
+            self.values.resize(last_n + 1, vote);
+        }
+        Ok(())
+    }
+
+    fn push_paper(&mut self, b: &EventBatch, t0: i64) -> Result<(), SamplingError> {
+        let t = &b.t;
+        let n = t.len();
+        let mut i = 0;
+        if let Some((tc, votes)) = self.carry.take() {
+            // the group at the end of the previous batch may continue here
+            let k = t.partition_point(|&v| v <= tc);
+            let extra: i64 = (0..k).map(|j| if b.p[j] { 1 } else { -1 }).sum();
+            if k == n {
+                self.carry = Some((tc, votes + extra));
+                return Ok(());
+            }
+            self.emit_upto(tc, sign(votes + extra), t0)?;
+            i = k;
+        }
+        while i < n {
+            // next sample time, and the first event at or after it
+            let tn = t0 + self.values.len() as i64 * self.dt;
+            let j = i + t[i..].partition_point(|&v| v < tn);
+            if j == n {
+                break;
+            }
+            let tg = t[j];
+            let k = j + t[j..].partition_point(|&v| v <= tg);
+            let votes: i64 = b.p[j..k].iter().map(|&p| if p { 1 } else { -1 }).sum();
+            if k == n {
+                self.carry = Some((tg, votes));
+                break;
+            }
+            self.emit_upto(tg, sign(votes), t0)?;
+            i = k;
+        }
+        Ok(())
+    }
+
+    fn flush_group(&mut self) -> Result<(), SamplingError> {
+        if let Some((t, bin, votes)) = self.group.take() {
+            self.check_bin(t, bin)?;
+            if self.values.len() <= bin {
+                self.values.resize(bin + 1, EMPTY);
+            }
+            // later groups in the same bin overwrite earlier ones: the last group wins
+            self.values[bin] = sign(votes);
+        }
+        Ok(())
+    }
+
+    fn push_authors(&mut self, b: &EventBatch, t0: i64) -> Result<(), SamplingError> {
+        for (&t, &p) in b.t.iter().zip(&b.p) {
+            let v = if p { 1 } else { -1 };
+            match &mut self.group {
+                Some((gt, _, votes)) if *gt == t => *votes += v,
+                _ => {
+                    self.flush_group()?;
+                    if t >= t0 {
+                        self.group = Some((t, ((t - t0) / self.dt) as usize, v));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn push_block(&mut self, b: &EventBatch, t0: i64) -> Result<(), SamplingError> {
+        let last = *b.t.last().unwrap();
+        let last_bin = ((last - t0).max(0) / self.dt) as usize;
+        self.check_bin(last, last_bin)?;
+        if self.counts.len() <= last_bin {
+            self.counts.resize(last_bin + 1, 0);
+        }
+        for (&t, &p) in b.t.iter().zip(&b.p) {
+            if t < t0 {
+                continue;
+            }
+            let bin = ((t - t0) / self.dt) as usize;
+            // out-of-order timestamps beyond the batch's last one are clamped, not trusted
+            let bin = bin.min(last_bin);
+            self.counts[bin] += if p { 1 } else { -1 };
+        }
+        Ok(())
+    }
+
+    /// Ends the stream and returns the sequence (empty when there were no events).
+    pub fn finish(mut self) -> Result<PolaritySequence, SamplingError> {
+        let t0 = self.t0.unwrap_or(0);
+        match self.method {
+            SamplingMethod::Paper => {
+                if let Some((tc, votes)) = self.carry.take() {
+                    self.emit_upto(tc, sign(votes), t0)?;
+                }
+            }
+            SamplingMethod::Authors => {
+                self.flush_group()?;
+                let mut prev = 0;
+                for v in &mut self.values {
+                    if *v == EMPTY {
+                        *v = prev;
+                    }
+                    prev = *v;
+                }
+            }
+            SamplingMethod::Block => {
+                self.values = self.counts.iter().map(|&c| c.signum() as i8).collect();
+            }
+        }
+        Ok(PolaritySequence {
+            t0_us: t0,
+            dt_us: self.dt,
+            values: self.values,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn batch(ev: &[(i64, bool)]) -> EventBatch {
+        let mut b = EventBatch::default();
+        for &(t, p) in ev {
+            b.push(t, 0, 0, p);
+        }
+        b
+    }
+
+    fn run(method: SamplingMethod, parts: &[&[(i64, bool)]]) -> Vec<i8> {
+        let mut s = TemporalSampler::new(method, 1000);
+        for p in parts {
+            s.push(&batch(p)).unwrap();
+        }
+        s.finish().unwrap().values
+    }
+
+    // events: t=0 (+,+,-), t=400 (-), t=2500 (-,-), t=2600 (+), t=3000 (+)
+    const EV: &[(i64, bool)] = &[
+        (0, true),
+        (0, true),
+        (0, false),
+        (400, false),
+        (2500, false),
+        (2500, false),
+        (2600, true),
+        (3000, true),
+    ];
+
+    #[test]
+    fn paper_takes_the_nearest_future_group() {
+        // t_0=0 → group at 0 (+1); t_1=1000 → next group ≥1000 is 2500 (−1); t_2=2000 → 2500;
+        // t_3=3000 → group at 3000 (+1)
+        assert_eq!(run(SamplingMethod::Paper, &[EV]), vec![1, -1, -1, 1]);
+    }
+
+    #[test]
+    fn authors_takes_the_last_group_in_the_bin_and_repeats_when_empty() {
+        // bin0 [0,1000): last group 400 (−1); bin1 empty → repeat −1; bin2: last group 2600 (+1);
+        // bin3: 3000 (+1)
+        assert_eq!(run(SamplingMethod::Authors, &[EV]), vec![-1, -1, 1, 1]);
+    }
+
+    #[test]
+    fn block_votes_over_the_bin() {
+        // bin0: +1+1−1−1 = 0; bin1: empty 0; bin2: −1−1+1 = −1; bin3: +1
+        assert_eq!(run(SamplingMethod::Block, &[EV]), vec![0, 0, -1, 1]);
+    }
+
+    #[test]
+    fn batch_boundaries_do_not_change_the_result() {
+        for method in [
+            SamplingMethod::Paper,
+            SamplingMethod::Authors,
+            SamplingMethod::Block,
+        ] {
+            let whole = run(method, &[EV]);
+            for cut in 1..EV.len() {
+                // cuts inside a group of equal timestamps too (cut = 1, 2, 5)
+                assert_eq!(
+                    run(method, &[&EV[..cut], &EV[cut..]]),
+                    whole,
+                    "{method:?} cut {cut}"
+                );
+            }
+            let singles: Vec<&[(i64, bool)]> = EV.chunks(1).collect();
+            assert_eq!(run(method, &singles), whole, "{method:?} one by one");
+        }
+    }
+
+    #[test]
+    fn a_wild_timestamp_is_an_error_not_an_allocation() {
+        let mut s = TemporalSampler::new(SamplingMethod::Block, 1000);
+        let e = s.push(&batch(&[(0, true), (i64::MAX / 2, true)]));
+        assert!(e.is_err());
+    }
+}
