@@ -5,7 +5,7 @@ use realfft::RealFftPlanner;
 
 use crate::butter::butter_bandpass;
 use crate::filtfilt::sosfiltfilt;
-use crate::postprocess::{median_correct, select_smoothest};
+use crate::postprocess::{median_correct, select_harmonics, HarmonicSelection};
 use crate::sampling::{PolaritySequence, SamplingError};
 use crate::tracker::{PeakMethod, StftTracker};
 
@@ -34,6 +34,8 @@ pub struct EnfParams {
     pub median_threshold_hz: f64,
     /// Harmonic-selection segment length, in estimates (T = 10 s at 1 s steps).
     pub segment_len: usize,
+    /// Harmonic-selection rule.
+    pub selection: HarmonicSelection,
 }
 
 impl Default for EnfParams {
@@ -50,6 +52,7 @@ impl Default for EnfParams {
             median_len: 21,
             median_threshold_hz: 0.02,
             segment_len: 10,
+            selection: HarmonicSelection::Consensus(0.005),
         }
     }
 }
@@ -172,7 +175,7 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfTrace, D
         })
         .collect();
     let traces: Vec<Vec<f64>> = harmonics.iter().map(|h| h.enf_hz.clone()).collect();
-    let (enf_hz, chosen) = select_smoothest(&traces, p.segment_len);
+    let (enf_hz, chosen) = select_harmonics(&traces, p.segment_len, p.selection);
     if enf_hz.iter().all(|v| !v.is_finite()) {
         return Err(DspError::NoTone("the flicker bands hold no signal".into()));
     }

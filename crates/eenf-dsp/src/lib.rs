@@ -32,5 +32,6 @@ pub use enf::{
 };
 pub use filtfilt::sosfiltfilt;
 pub use metrics::{agreement, Agreement};
+pub use postprocess::{median_correct, select_harmonics, HarmonicSelection};
 pub use sampling::{PolaritySequence, SamplingError, SamplingMethod, TemporalSampler};
 pub use tracker::{PeakMethod, StftTracker};

@@ -31,10 +31,25 @@ pub fn median_correct(trace: &[f64], len: usize, threshold: f64) -> Vec<f64> {
         .collect()
 }
 
-/// Picks, in each segment of `segment` estimates, the trace that is smoothest
-/// (smallest Σ|f[n] − f[n−1]| inside the segment). `traces` are on a common scale (the ENF).
+/// How the harmonic of each segment is chosen.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HarmonicSelection {
+    /// The paper's rule: the smoothest trace (smallest Σ|f[n] − f[n−1]|) in the segment.
+    Smoothest,
+    /// The smoothest among the traces that agree with at least one other trace (within the
+    /// tolerance, Hz, on the ENF scale) for the most estimates of the segment. A band that
+    /// locked onto noise is flat after outlier correction, so the paper's rule alone prefers it.
+    Consensus(f64),
+}
+
+/// Picks a trace per segment of `segment` estimates. `traces` are on a common scale (the ENF).
 /// Returns the combined trace and the index of the trace chosen for each segment.
-pub fn select_smoothest(traces: &[Vec<f64>], segment: usize) -> (Vec<f64>, Vec<usize>) {
+pub fn select_harmonics(
+    traces: &[Vec<f64>],
+    segment: usize,
+    rule: HarmonicSelection,
+) -> (Vec<f64>, Vec<usize>) {
     let n = traces.iter().map(|t| t.len()).min().unwrap_or(0);
     let segment = segment.max(1);
     let mut out = Vec::with_capacity(n);
@@ -49,11 +64,30 @@ pub fn select_smoothest(traces: &[Vec<f64>], segment: usize) -> (Vec<f64>, Vec<u
                 f64::INFINITY
             }
         };
-        let best = (0..traces.len())
+        let mut candidates: Vec<usize> = (0..traces.len()).collect();
+        if let HarmonicSelection::Consensus(tol) = rule {
+            // agreement score: estimates of the segment at which another trace is within tol
+            let score = |a: usize| -> usize {
+                (start..end)
+                    .filter(|&i| {
+                        (0..traces.len())
+                            .any(|b| b != a && (traces[a][i] - traces[b][i]).abs() <= tol)
+                    })
+                    .count()
+            };
+            let scores: Vec<usize> = candidates.iter().map(|&a| score(a)).collect();
+            let best = scores.iter().copied().max().unwrap_or(0);
+            if best > 0 {
+                candidates.retain(|&a| scores[a] == best);
+            }
+        }
+        let pick = candidates
+            .iter()
+            .copied()
             .min_by(|&a, &b| roughness(&traces[a]).total_cmp(&roughness(&traces[b])))
             .unwrap_or(0);
-        chosen.push(best);
-        out.extend_from_slice(&traces[best][start..end]);
+        chosen.push(pick);
+        out.extend_from_slice(&traces[pick][start..end]);
     }
     (out, chosen)
 }
@@ -85,8 +119,32 @@ mod tests {
         for (i, v) in rough_late.iter_mut().enumerate().skip(10) {
             *v += if i % 2 == 0 { 0.02 } else { -0.02 };
         }
-        let (out, chosen) = select_smoothest(&[noisy, rough_late.clone()], 10);
+        let (out, chosen) = select_harmonics(
+            &[noisy, rough_late.clone()],
+            10,
+            HarmonicSelection::Smoothest,
+        );
         assert_eq!(chosen, vec![1, 0]);
         assert_eq!(out[..10], rough_late[..10]);
+    }
+
+    #[test]
+    fn consensus_ignores_a_flat_trace_that_agrees_with_nothing() {
+        let truth: Vec<f64> = (0..10).map(|i| 50.0 + 1e-3 * (i as f64).sin()).collect();
+        let a: Vec<f64> = truth.iter().map(|v| v + 2e-4).collect();
+        let b: Vec<f64> = truth.iter().map(|v| v - 3e-4).collect();
+        let locked = vec![50.15; 10]; // a band stuck on a spurious line: perfectly flat
+        let traces = [a, b, locked];
+        let (_, paper) = select_harmonics(&traces, 10, HarmonicSelection::Smoothest);
+        assert_eq!(
+            paper,
+            vec![2],
+            "the paper's rule takes the flat wrong trace"
+        );
+        let (_, robust) = select_harmonics(&traces, 10, HarmonicSelection::Consensus(0.005));
+        assert!(robust[0] < 2, "{robust:?}");
+        // a single trace is taken as it is
+        let (out, c) = select_harmonics(&traces[2..], 10, HarmonicSelection::Consensus(0.005));
+        assert_eq!((out[0], c[0]), (50.15, 0));
     }
 }

@@ -43,50 +43,74 @@ pub enum MainsError {
     },
 }
 
-/// Statistics of the synthetic ENF process (real grids: std ≈ 20 mHz, 1 s steps ≈ 0.5 mHz).
+/// The synthetic ENF process: a slow Ornstein–Uhlenbeck wander, "swings" (ramps whose rate is
+/// itself a random process, pulled back towards the slow level) and per-second jitter.
+/// Defaults are fitted to the shared Wuhan references as the reference tracker sees them:
+/// std ≈ 20 mHz, 60 s ranges with median ≈ 20 mHz, 1 s steps with std ≈ 1 mHz that are only
+/// weakly correlated.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct SyntheticEnf {
-    /// Stationary standard deviation, Hz.
-    pub std_hz: f64,
-    /// Standard deviation of the 1 s steps, Hz.
-    pub step_std_hz: f64,
+    /// Standard deviation of the slow wander, Hz.
+    pub slow_std_hz: f64,
+    /// Correlation time of the slow wander, s.
+    pub slow_tau_s: f64,
+    /// Standard deviation of the swing rate, Hz per second.
+    pub rate_std_hz: f64,
+    /// Correlation time of the swing rate, s.
+    pub rate_tau_s: f64,
+    /// Time constant pulling a swing back, s.
+    pub restore_tau_s: f64,
+    /// Per-second jitter, Hz.
+    pub jitter_std_hz: f64,
 }
 
 impl Default for SyntheticEnf {
     fn default() -> Self {
         SyntheticEnf {
-            std_hz: 0.020,
-            step_std_hz: 0.0005,
+            slow_std_hz: 0.015,
+            slow_tau_s: 1800.0,
+            rate_std_hz: 0.0007,
+            rate_tau_s: 15.0,
+            restore_tau_s: 60.0,
+            jitter_std_hz: 0.011,
         }
+    }
+}
+
+impl SyntheticEnf {
+    /// `seconds` values of the ENF at 1 s steps around `nominal_hz`.
+    pub fn per_second(&self, nominal_hz: f64, seconds: usize, seed: u64) -> Vec<f64> {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let mut g = || rng.sample::<f64, _>(StandardNormal);
+        let a = (-1.0 / self.slow_tau_s).exp();
+        let av = (-1.0 / self.rate_tau_s).exp();
+        let mut slow = self.slow_std_hz * g();
+        let mut rate = self.rate_std_hz * g();
+        let mut swing = 0.0;
+        let warmup = (5.0 * self.restore_tau_s) as usize;
+        let mut out = Vec::with_capacity(seconds);
+        for i in 0..warmup + seconds {
+            slow = a * slow + self.slow_std_hz * (1.0 - a * a).sqrt() * g();
+            rate = av * rate + self.rate_std_hz * (1.0 - av * av).sqrt() * g();
+            swing = swing * (1.0 - 1.0 / self.restore_tau_s) + rate;
+            let jitter = self.jitter_std_hz * g();
+            if i >= warmup {
+                out.push(nominal_hz + slow + swing + jitter);
+            }
+        }
+        out
     }
 }
 
 const PHASE_FS: f64 = 1000.0;
 
 impl MainsPhase {
-    /// A wandering ENF: an Ornstein–Uhlenbeck process at 1 s steps with the given statistics,
-    /// interpolated linearly in between and integrated into phase.
+    /// A wandering ENF from the synthetic process, linearly interpolated between seconds and
+    /// integrated into phase.
     pub fn synthetic(nominal_hz: f64, duration_s: f64, stats: SyntheticEnf, seed: u64) -> Self {
-        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-        let a = (1.0 - (stats.step_std_hz / stats.std_hz).powi(2))
-            .max(0.0)
-            .sqrt();
-        let seconds = duration_s.ceil() as usize + 2;
-        let mut dev = stats.std_hz * rng.sample::<f64, _>(StandardNormal);
-        let per_second: Vec<f64> = (0..seconds)
-            .map(|_| {
-                let v = nominal_hz + dev;
-                dev = a * dev + stats.step_std_hz * rng.sample::<f64, _>(StandardNormal);
-                v
-            })
-            .collect();
-        Self::from_frequency(
-            nominal_hz,
-            &per_second,
-            1.0,
-            duration_s,
-            rng.gen::<f64>() * 2.0 * PI,
-        )
+        let per_second = stats.per_second(nominal_hz, duration_s.ceil() as usize + 2, seed);
+        let phase0 = (seed % 6283) as f64 * 1e-3;
+        Self::from_frequency(nominal_hz, &per_second, 1.0, duration_s, phase0)
     }
 
     /// Integrates a frequency trace given every `step_s` seconds (linear in between).
@@ -237,20 +261,33 @@ mod tests {
 
     #[test]
     fn synthetic_enf_has_grid_like_statistics() {
-        let m = MainsPhase::synthetic(50.0, 4000.0, SyntheticEnf::default(), 7);
-        // per-second mean frequency from the phase
-        let f: Vec<f64> = (0..4000)
-            .map(|s| (m.phase_at(s as f64 + 1.0) - m.phase_at(s as f64)) / (2.0 * PI))
+        // statistics of the trace as a 16 s tracker sees it, compared with the real references
+        let raw = SyntheticEnf::default().per_second(50.0, 6 * 3600, 7);
+        let smooth: Vec<f64> = (8..raw.len() - 8)
+            .map(|i| raw[i - 8..i + 8].iter().sum::<f64>() / 16.0)
             .collect();
-        let steps: Vec<f64> = f.windows(2).map(|w| w[1] - w[0]).collect();
         let sd = |v: &[f64]| {
             let mean = v.iter().sum::<f64>() / v.len() as f64;
             (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
         };
+        let steps: Vec<f64> = smooth.windows(2).map(|w| w[1] - w[0]).collect();
         let step_sd = sd(&steps);
-        assert!(step_sd > 0.0003 && step_sd < 0.0008, "step sd {step_sd}");
-        let mean = f.iter().sum::<f64>() / f.len() as f64;
-        assert!((mean - 50.0).abs() < 0.06, "mean {mean}");
+        assert!(step_sd > 0.0006 && step_sd < 0.002, "step sd {step_sd}");
+        let total = sd(&smooth);
+        assert!(total > 0.010 && total < 0.035, "std {total}");
+        let mut ranges: Vec<f64> = smooth
+            .chunks(60)
+            .map(|w| {
+                w.iter().cloned().fold(f64::MIN, f64::max)
+                    - w.iter().cloned().fold(f64::MAX, f64::min)
+            })
+            .collect();
+        ranges.sort_by(f64::total_cmp);
+        let median = ranges[ranges.len() / 2];
+        assert!(
+            median > 0.010 && median < 0.035,
+            "median 60 s range {median}"
+        );
     }
 
     #[test]

@@ -1,1 +1,59 @@
-fn main() {}
+//! `eenf`: Electric Network Frequency from event cameras.
+
+mod commands;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Recover the Electric Network Frequency (ENF) from event-camera recordings.
+///
+/// Lamps on the mains flicker at twice the grid frequency; an event camera sees that flicker,
+/// and eenf recovers the grid's frequency from it (the E-ENF method, CVPR 2023), builds the
+/// reference from mains recordings, and compares the two.
+#[derive(Parser)]
+#[command(name = "eenf", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    /// No progress bars.
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Show what an event file holds: format, codec, resolution, streams, events, time span.
+    Info(commands::info::Args),
+    /// Extract the ENF trace from an event recording (E-ENF).
+    Extract(commands::extract::Args),
+    /// Build the reference ENF trace from a mains/audio WAV recording.
+    Reference(commands::reference::Args),
+    /// Compare an ENF trace with a reference: CC, MAE, RMSE, max error.
+    Compare(commands::compare::Args),
+    /// Simulate an event recording of a flickering scene, with its ground-truth ENF.
+    Simulate(commands::simulate::Args),
+    /// Simulate 60 s, extract the ENF, compare it with the truth: the whole method in one go.
+    Demo(commands::demo::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let progress = eenf_cli::progress::Progress::new(cli.quiet);
+    let result = match cli.command {
+        Command::Info(a) => commands::info::run(a),
+        Command::Extract(a) => commands::extract::run(a, progress),
+        Command::Reference(a) => commands::reference::run(a, progress),
+        Command::Compare(a) => commands::compare::run(a, progress),
+        Command::Simulate(a) => commands::simulate::run(a, progress).map(|_| ()),
+        Command::Demo(a) => commands::demo::run(a, progress),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // one line: the causes joined, each naming what it is about
+            eprintln!("eenf: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,88 @@
+//! `eenf info`: what an event file holds.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use eenf_cli::output::utc_string;
+use eenf_events::StreamStats;
+
+/// Arguments of `eenf info`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The event file (format found from its content).
+    pub file: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let mut reader = eenf_events::open(&a.file)?;
+    let info = reader.info().clone();
+    let stats = StreamStats::scan(reader.as_mut())?;
+    let duration_s = match (stats.first_t, stats.last_t) {
+        (Some(f), Some(l)) => (l - f) as f64 * 1e-6,
+        _ => 0.0,
+    };
+    let rate = if duration_s > 0.0 {
+        stats.events as f64 / duration_s
+    } else {
+        0.0
+    };
+    // resolution: header, else the data's extent
+    let width = info.width.or(stats.x_range.map(|r| r.1 + 1));
+    let height = info.height.or(stats.y_range.map(|r| r.1 + 1));
+    if a.json {
+        let streams: Vec<_> = info
+            .streams
+            .iter()
+            .map(|s| {
+                serde_json::json!({"id": s.id, "type": s.kind, "width": s.width,
+                    "height": s.height, "source": s.source})
+            })
+            .collect();
+        let v = serde_json::json!({
+            "file": a.file, "format": info.format, "codec": info.codec,
+            "width": width, "height": height, "streams": streams, "indexed": info.indexed,
+            "events": stats.events, "on_events": stats.on,
+            "first_t_us": stats.first_t, "last_t_us": stats.last_t,
+            "duration_s": duration_s, "events_per_s": rate,
+            "x_range": stats.x_range, "y_range": stats.y_range,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    println!("file        {}", a.file.display());
+    match &info.codec {
+        Some(c) => println!("format      {} (compression {c})", info.format),
+        None => println!("format      {}", info.format),
+    }
+    match (width, height) {
+        (Some(w), Some(h)) => println!("resolution  {w} x {h}"),
+        _ => println!("resolution  unknown"),
+    }
+    if !info.streams.is_empty() {
+        let list: Vec<String> = info
+            .streams
+            .iter()
+            .map(|s| match (s.width, s.height) {
+                (Some(w), Some(h)) => format!("{} {} {w}x{h}", s.id, s.kind),
+                _ => format!("{} {}", s.id, s.kind),
+            })
+            .collect();
+        println!("streams     {}", list.join(", "));
+    }
+    println!(
+        "events      {} ({} ON, {} OFF)",
+        stats.events,
+        stats.on,
+        stats.events - stats.on
+    );
+    if let (Some(f), Some(l)) = (stats.first_t, stats.last_t) {
+        println!("first t     {f} us ({})", utc_string(f));
+        println!("last t      {l} us ({})", utc_string(l));
+        println!("duration    {duration_s:.6} s");
+        println!("rate        {:.3} M events/s", rate / 1e6);
+    }
+    Ok(())
+}

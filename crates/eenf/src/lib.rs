@@ -1,0 +1,14 @@
+//! # eenf (library part of the command-line tool)
+//!
+//! The commands of `eenf` are thin wrappers over these functions, which tests and benchmarks
+//! call directly: [`pipeline::extract_file`] (event file → ENF trace),
+//! [`pipeline::reference_file`] (mains WAV → reference trace),
+//! [`pipeline::reference_for_recording`] (a dataset's hourly references → the reference of one
+//! recording) and [`pipeline::align`].
+
+pub mod dataset;
+pub mod output;
+pub mod pipeline;
+pub mod plot;
+pub mod progress;
+pub mod wav;
