@@ -1,1 +1,98 @@
-fn main() {}
+//! Decoding and extraction throughput on a DVXplorer-like recording: 2 M events/s, scan groups
+//! of events sharing a timestamp, polarity following a 100 Hz flicker.
+//!
+//! The file is generated once into the target folder (`EENF_BENCH_SECONDS`, default 20 s =
+//! 40 M events) and reused; `cargo bench -p eenf` prints events/s ("elem/s").
+
+use std::path::PathBuf;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use eenf_cli::pipeline::{extract_file, ExtractOptions, Nominal};
+use eenf_cli::progress::Progress;
+use eenf_events::{Aedat4Writer, Compression, EventBatch};
+
+const RATE: u64 = 2_000_000;
+const SCAN_US: i64 = 200;
+
+/// Writes (once) a flicker recording of `seconds` with the given codec; returns its path and
+/// event count.
+fn fixture(seconds: u64, codec: Compression) -> (PathBuf, u64) {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let path = dir.join(format!("bench-{seconds}s-{}.aedat4", codec.name()));
+    let per_scan = (RATE * SCAN_US as u64 / 1_000_000) as usize;
+    let scans = seconds * 1_000_000 / SCAN_US as u64;
+    let total = scans * per_scan as u64;
+    if path.exists() {
+        return (path, total);
+    }
+    let mut w = Aedat4Writer::create(&path, codec, 640, 480).unwrap();
+    let mut state = 0x2545f4914f6cdd1du64;
+    let mut next = || {
+        state ^= state >> 12;
+        state ^= state << 25;
+        state ^= state >> 27;
+        state.wrapping_mul(0x2545f4914f6cdd1d)
+    };
+    let mut batch = EventBatch::with_capacity(per_scan * 5000);
+    for s in 0..scans {
+        let t = s as i64 * SCAN_US;
+        // light ∝ cos²(2π·50.01·t): ON while it rises, OFF while it falls, 15 % noise
+        let rising = (4.0 * std::f64::consts::PI * 50.01 * t as f64 * 1e-6).sin() < 0.0;
+        for _ in 0..per_scan {
+            let r = next();
+            let noisy = (r >> 60) < 2;
+            batch.push(
+                1_660_723_800_000_000 + t,
+                (r % 640) as u16,
+                ((r >> 16) % 480) as u16,
+                rising ^ noisy,
+            );
+        }
+        if batch.len() >= per_scan * 5000 {
+            w.write(&batch).unwrap();
+            batch.clear();
+        }
+    }
+    w.write(&batch).unwrap();
+    w.finish().unwrap();
+    (path, total)
+}
+
+fn benches(c: &mut Criterion) {
+    let seconds: u64 = std::env::var("EENF_BENCH_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20);
+    for codec in [Compression::Lz4, Compression::Zstd] {
+        let (path, n) = fixture(seconds, codec);
+        let mut g = c.benchmark_group(format!("aedat4_{}", codec.name()));
+        g.sample_size(10);
+        g.throughput(Throughput::Elements(n));
+        g.bench_function("decode", |b| {
+            b.iter(|| {
+                let mut r = eenf_events::open(&path).unwrap();
+                let mut count = 0usize;
+                while let Some(batch) = r.next_batch().unwrap() {
+                    count += batch.len();
+                }
+                assert_eq!(count as u64, n);
+            })
+        });
+        if codec == Compression::Lz4 {
+            let opts = ExtractOptions {
+                nominal: Nominal::Hz(50.0),
+                ..ExtractOptions::default()
+            };
+            g.bench_function("extract_enf", |b| {
+                b.iter(|| {
+                    let x = extract_file(&path, &opts, &Progress::hidden()).unwrap();
+                    assert_eq!(x.events, n);
+                })
+            });
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(pipeline, benches);
+criterion_main!(pipeline);

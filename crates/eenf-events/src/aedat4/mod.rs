@@ -5,6 +5,7 @@
 //! optional FileDataTable at the end.
 
 mod flatbuf;
+mod lz4;
 mod writer;
 
 use std::collections::VecDeque;
@@ -159,20 +160,43 @@ fn attr_value(tag: &str, name: &str) -> Option<String> {
     Some(tag[start..start + len].to_string())
 }
 
-/// Decompresses one packet body. The output size is bounded so that a corrupt frame cannot
-/// make us allocate without limit.
-fn decompress(codec: Compression, body: &[u8]) -> std::result::Result<Vec<u8>, String> {
-    let mut out = Vec::with_capacity(body.len() * 3);
-    let res = match codec {
-        Compression::None => return Ok(body.to_vec()),
-        Compression::Lz4 | Compression::Lz4High => lz4_flex::frame::FrameDecoder::new(body)
-            .take(MAX_CHUNK)
-            .read_to_end(&mut out),
-        Compression::Zstd | Compression::ZstdHigh => zstd::stream::read::Decoder::new(body)
-            .and_then(|d| d.take(MAX_CHUNK).read_to_end(&mut out)),
-    };
-    res.map_err(|e| format!("{} decompression failed: {e}", codec.name()))?;
-    Ok(out)
+/// Decompresses one packet body into `scratch` (reused between packets, so it is zero-filled
+/// only when it grows) and returns the decompressed bytes. The output size is bounded so that a
+/// corrupt frame cannot make us allocate without limit.
+fn decompress<'a>(
+    codec: Compression,
+    body: &'a [u8],
+    scratch: &'a mut Vec<u8>,
+) -> std::result::Result<&'a [u8], String> {
+    match codec {
+        Compression::None => Ok(body),
+        Compression::Lz4 | Compression::Lz4High => {
+            let n = lz4::decode_frames(body, scratch)?;
+            Ok(&scratch[..n])
+        }
+        Compression::Zstd | Compression::ZstdHigh => {
+            let fail = |e: &dyn std::fmt::Display| format!("ZSTD decompression failed: {e}");
+            match zstd::zstd_safe::get_frame_content_size(body) {
+                Ok(Some(size)) if size <= MAX_CHUNK && body.len() >= 4 => {
+                    let size = size as usize;
+                    if scratch.len() < size {
+                        scratch.resize(size, 0);
+                    }
+                    let n = zstd::bulk::decompress_to_buffer(body, &mut scratch[..size])
+                        .map_err(|e| fail(&e))?;
+                    Ok(&scratch[..n])
+                }
+                _ => {
+                    // no size in the frame header: stream it
+                    scratch.clear();
+                    zstd::stream::read::Decoder::new(body)
+                        .and_then(|d| d.take(MAX_CHUNK).read_to_end(scratch))
+                        .map_err(|e| fail(&e))?;
+                    Ok(&scratch[..])
+                }
+            }
+        }
+    }
 }
 
 /// Decodes a decompressed packet body. `Ok(None)` when the packet is not an event packet.
@@ -227,6 +251,21 @@ pub struct Aedat4Reader {
     info: StreamInfo,
     pending: VecDeque<EventBatch>,
     failed: Option<EventError>,
+    /// Packets read and waiting to be decoded (the first `ready` slots).
+    current: Vec<Slot>,
+    ready: usize,
+    /// The error that stopped reading `current`, reported after its packets.
+    read_error: Option<EventError>,
+    /// Buffers the next round is read into while `current` decodes.
+    next: Vec<Slot>,
+}
+
+/// One packet body, in a buffer reused from round to round.
+#[derive(Default)]
+struct Slot {
+    at: u64,
+    body: Vec<u8>,
+    size: usize,
 }
 
 impl Aedat4Reader {
@@ -317,78 +356,123 @@ impl Aedat4Reader {
             info,
             pending: VecDeque::new(),
             failed: None,
+            current: Vec::new(),
+            ready: 0,
+            read_error: None,
+            next: Vec::new(),
         })
     }
 
-    /// Reads the next round of event packets and decodes them in parallel.
-    fn fill(&mut self) -> Result<()> {
-        let mut raw: Vec<(u64, Vec<u8>)> = Vec::with_capacity(PACKETS_PER_ROUND);
-        let mut failure = None;
-        while raw.len() < PACKETS_PER_ROUND && self.pos < self.end {
+    /// Reads up to one round of event packets into `slots`; returns how many were read and the
+    /// error that stopped the reading, if any.
+    fn read_round(&mut self, slots: &mut Vec<Slot>) -> (usize, Option<EventError>) {
+        let mut count = 0;
+        while count < PACKETS_PER_ROUND && self.pos < self.end {
             let at = self.pos;
             if self.end - at < 8 {
-                failure = Some(self.truncated(at, "packet header"));
-                break;
+                return (count, Some(self.truncated(at, "packet header")));
             }
             let mut hdr = [0u8; 8];
             if let Err(e) = self.file.read_exact(&mut hdr) {
-                failure = Some(io_err(&self.path, e));
-                break;
+                return (count, Some(io_err(&self.path, e)));
             }
             let stream = i32::from_le_bytes(hdr[0..4].try_into().unwrap());
             let size = i32::from_le_bytes(hdr[4..8].try_into().unwrap());
             if size < 0 || size as u64 > MAX_CHUNK {
-                failure = Some(self.corrupt(at, format!("packet size {size}")));
-                break;
+                return (count, Some(self.corrupt(at, format!("packet size {size}"))));
             }
             let size = size as u64;
             if size > self.end - at - 8 {
-                failure = Some(self.truncated(
-                    at,
-                    &format!(
-                        "packet of {size} bytes, only {} bytes left",
-                        self.end - at - 8
-                    ),
-                ));
-                break;
+                let left = self.end - at - 8;
+                return (
+                    count,
+                    Some(self.truncated(
+                        at,
+                        &format!("packet of {size} bytes, only {left} bytes left"),
+                    )),
+                );
             }
             self.pos = at + 8 + size;
             let wanted = self.event_streams.is_empty() || self.event_streams.contains(&stream);
             if wanted {
-                let mut body = vec![0u8; size as usize];
-                if let Err(e) = self.file.read_exact(&mut body) {
-                    failure = Some(io_err(&self.path, e));
-                    break;
+                if slots.len() <= count {
+                    slots.push(Slot::default());
                 }
-                raw.push((at, body));
+                let slot = &mut slots[count];
+                // grown, never shrunk: no zero-filling once warm
+                if slot.body.len() < size as usize {
+                    slot.body.resize(size as usize, 0);
+                }
+                if let Err(e) = self.file.read_exact(&mut slot.body[..size as usize]) {
+                    return (count, Some(io_err(&self.path, e)));
+                }
+                slot.at = at;
+                slot.size = size as usize;
+                count += 1;
             } else if let Err(e) = self.file.seek_relative(size as i64) {
-                failure = Some(io_err(&self.path, e));
-                break;
+                return (count, Some(io_err(&self.path, e)));
             }
         }
+        (count, None)
+    }
+
+    /// Decodes the packets read last time in parallel while reading the next round.
+    fn fill(&mut self) -> Result<()> {
+        if self.ready == 0 && self.read_error.is_none() {
+            let mut slots = std::mem::take(&mut self.current);
+            let (n, err) = self.read_round(&mut slots);
+            self.current = slots;
+            self.ready = n;
+            self.read_error = err;
+        }
         let codec = self.codec;
-        let decoded: Vec<std::result::Result<Option<EventBatch>, (u64, String)>> = raw
-            .par_iter()
-            .map(|(at, body)| {
-                decompress(codec, body)
-                    .and_then(|d| decode_event_packet(&d))
-                    .map_err(|e| (*at, e))
-            })
-            .collect();
+        let ready = self.ready;
+        let current = std::mem::take(&mut self.current);
+        let mut next = std::mem::take(&mut self.next);
+        let more = self.read_error.is_none() && self.pos < self.end;
+        let (decoded, (n_next, err_next)) = rayon::join(
+            || -> Vec<std::result::Result<Option<EventBatch>, (u64, String)>> {
+                current[..ready]
+                    .par_iter()
+                    .map_init(Vec::new, |scratch, slot| {
+                        decompress(codec, &slot.body[..slot.size], scratch)
+                            .and_then(decode_event_packet)
+                            .map_err(|e| (slot.at, e))
+                    })
+                    .collect()
+            },
+            || {
+                if more {
+                    self.read_round(&mut next)
+                } else {
+                    (0, None)
+                }
+            },
+        );
+        // the round just read becomes the current one
+        self.next = current;
+        self.current = next;
+        self.ready = n_next;
+        let read_error = std::mem::replace(&mut self.read_error, err_next);
         for d in decoded {
             match d {
                 Ok(Some(b)) if !b.is_empty() => self.pending.push_back(b),
                 Ok(_) => {}
                 Err((at, reason)) => {
-                    // Deliver the events before the damage, then the error.
+                    // deliver the events before the damage, then the error
                     self.failed = Some(self.corrupt(at, reason));
+                    self.ready = 0;
+                    self.read_error = None;
                     self.pos = self.end;
                     return Ok(());
                 }
             }
         }
-        if let Some(f) = failure {
-            self.failed = Some(f);
+        if let Some(e) = read_error {
+            // the packets read before the error are decoded already; report it now
+            self.failed = Some(e);
+            self.ready = 0;
+            self.read_error = None;
             self.pos = self.end;
         }
         Ok(())
@@ -440,8 +524,9 @@ fn read_table(
     file.seek(SeekFrom::Start(pos)).map_err(|e| e.to_string())?;
     let mut raw = vec![0u8; len as usize];
     file.read_exact(&mut raw).map_err(|e| e.to_string())?;
-    let body = decompress(codec, &raw)?;
-    let t = Table::size_prefixed_root(&body, Some(b"FTAB")).map_err(|e| e.0)?;
+    let mut scratch = Vec::new();
+    let body = decompress(codec, &raw, &mut scratch)?;
+    let t = Table::size_prefixed_root(body, Some(b"FTAB")).map_err(|e| e.0)?;
     let mut s = TableSummary::default();
     for entry in t.table_vector(0).map_err(|e| e.0)? {
         let header = entry.struct_field(1, 8).map_err(|e| e.0)?;
@@ -473,7 +558,7 @@ impl EventReader for Aedat4Reader {
             if let Some(e) = self.failed.take() {
                 return Err(e);
             }
-            if self.pos >= self.end {
+            if self.pos >= self.end && self.ready == 0 && self.read_error.is_none() {
                 return Ok(None);
             }
             self.fill()?;

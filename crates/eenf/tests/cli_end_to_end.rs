@@ -1,0 +1,161 @@
+//! The commands chained as a user would: simulate → extract → compare, and the alignment of a
+//! dataset-named recording with a folder of hourly references, across an hour boundary.
+
+use std::path::Path;
+use std::process::Command;
+
+use eenf_events::{Aedat4Writer, Compression};
+use eenf_sim::{simulate, MainsPhase, SimConfig, SyntheticEnf};
+
+fn eenf(args: &[&str], dir: &Path) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_eenf"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{args:?}: {stderr}");
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn json(text: &str) -> serde_json::Value {
+    serde_json::from_str(text).unwrap()
+}
+
+#[test]
+fn simulate_extract_compare_meets_the_papers_accuracy() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    eenf(
+        &[
+            "-q",
+            "simulate",
+            "--duration",
+            "45",
+            "--resolution",
+            "40x30",
+            "--seed",
+            "3",
+            "-o",
+            "s.aedat4",
+        ],
+        d,
+    );
+    let info = json(&eenf(&["info", "--json", "s.aedat4"], d));
+    assert_eq!(info["format"], "AEDAT 4.0");
+    assert_eq!(
+        (info["width"].as_u64(), info["height"].as_u64()),
+        (Some(40), Some(30))
+    );
+    assert!(info["events"].as_u64().unwrap() > 100_000);
+    let x = json(&eenf(
+        &[
+            "extract",
+            "s.aedat4",
+            "--json",
+            "-o",
+            "s.enf.csv",
+            "--plot",
+            "s.svg",
+        ],
+        d,
+    ));
+    assert_eq!(x["nominal_hz"], 50.0);
+    assert_eq!(x["enf_hz"].as_array().unwrap().len(), 46);
+    assert!(d.join("s.svg").metadata().unwrap().len() > 1000);
+    let csv = std::fs::read_to_string(d.join("s.enf.csv")).unwrap();
+    let first: Vec<&str> = csv.lines().nth(1).unwrap().split(',').collect();
+    assert_eq!(csv.lines().next(), Some("time_s,enf_hz"));
+    assert_eq!(first[0], "0");
+    assert!(
+        (first[1].parse::<f64>().unwrap() - 50.0).abs() < 0.2,
+        "{first:?}"
+    );
+    let c = json(&eenf(
+        &[
+            "compare",
+            "s.enf.csv",
+            "s.truth.csv",
+            "--json",
+            "--plot",
+            "c.png",
+        ],
+        d,
+    ));
+    let (cc, mae) = (c["cc"].as_f64().unwrap(), c["mae_hz"].as_f64().unwrap());
+    assert!(cc >= 0.95 && mae <= 0.002, "CC {cc} MAE {mae}");
+    assert_eq!(c["seconds"], 46);
+    assert!(d.join("c.png").metadata().unwrap().len() > 1000);
+}
+
+#[test]
+fn hourly_references_align_by_name_across_the_hour() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    // two hours of mains at 200 Hz, 16:00 and 17:00, one continuous signal split in two files
+    let mains = MainsPhase::synthetic(50.0, 7200.0, SyntheticEnf::default(), 42);
+    let fs = 200.0;
+    let volts: Vec<f64> = (0..(7200.0 * fs) as usize)
+        .map(|i| 0.6 * mains.phase_at(i as f64 / fs).cos())
+        .collect();
+    let refs = d.join("ENF_Reference");
+    std::fs::create_dir(&refs).unwrap();
+    let hour = (3600.0 * fs) as usize;
+    eenf_cli::wav::write_wav(
+        &refs.join("2022_08_17_Wed_16_00_00.wav"),
+        200,
+        &volts[..hour],
+    )
+    .unwrap();
+    eenf_cli::wav::write_wav(
+        &refs.join("2022_08_17_Wed_17_00_00.wav"),
+        200,
+        &volts[hour..],
+    )
+    .unwrap();
+    // a 60 s recording from 16:59:30, driven by the same mains
+    let start = 59.0 * 60.0 + 30.0;
+    let phase = MainsPhase::from_recording(&volts, fs, 50.0, start, 60.0).unwrap();
+    let config = SimConfig {
+        width: 40,
+        height: 30,
+        duration_s: 60.0,
+        seed: 5,
+        ..SimConfig::default()
+    };
+    let rec = d.join("dvSave-2022_08_17_16_59_30.aedat4");
+    let mut w = Aedat4Writer::create(&rec, Compression::Zstd, 40, 30).unwrap();
+    simulate(&config, &phase, |b| w.write(b)).unwrap();
+    w.finish().unwrap();
+
+    eenf(
+        &["-q", "extract", rec.to_str().unwrap(), "-o", "trace.json"],
+        d,
+    );
+    let c = json(&eenf(
+        &["compare", "trace.json", "ENF_Reference", "--json"],
+        d,
+    ));
+    let (cc, mae) = (c["cc"].as_f64().unwrap(), c["mae_hz"].as_f64().unwrap());
+    let est = json(&std::fs::read_to_string(d.join("trace.json")).unwrap());
+    let n = est["enf_hz"].as_array().unwrap().len();
+    assert!(n >= 60, "{n} estimates");
+    assert_eq!(
+        c["seconds"], n,
+        "all seconds, including those after 17:00, are compared"
+    );
+    assert!(cc >= 0.95 && mae <= 0.002, "CC {cc} MAE {mae}");
+    // a wrong offset is visibly worse: the alignment really comes from the name
+    let off = json(&eenf(
+        &[
+            "compare",
+            "trace.json",
+            "ENF_Reference",
+            "--json",
+            "--offset-s",
+            "-40",
+        ],
+        d,
+    ));
+    assert!(off["mae_hz"].as_f64().unwrap() > 2.0 * mae, "{off}");
+}

@@ -1,0 +1,180 @@
+//! Bad input never panics: each case exits non-zero with one line naming the file and cause.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use eenf_events::{Aedat4Writer, Compression};
+
+fn eenf(args: &[&str], dir: &Path) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_eenf"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Runs a command that must fail, and checks the one-line message.
+fn fails(args: &[&str], dir: &Path, file: &str, cause: &str) {
+    let (ok, _, err) = eenf(args, dir);
+    assert!(!ok, "{args:?} succeeded");
+    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "{args:?}: expected one line, got {err:?}");
+    assert!(lines[0].starts_with("eenf: error: "), "{err}");
+    assert!(
+        lines[0].contains(file),
+        "{args:?}: {err} does not name {file}"
+    );
+    assert!(
+        lines[0].to_lowercase().contains(&cause.to_lowercase()),
+        "{args:?}: {err} does not say {cause:?}"
+    );
+}
+
+fn simulate(dir: &Path, name: &str, seconds: &str) -> PathBuf {
+    let (ok, _, err) = eenf(
+        &[
+            "-q",
+            "simulate",
+            "--duration",
+            seconds,
+            "--resolution",
+            "24x18",
+            "-o",
+            name,
+        ],
+        dir,
+    );
+    assert!(ok, "{err}");
+    dir.join(name)
+}
+
+#[test]
+fn bad_inputs_give_one_line_errors() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+
+    fails(
+        &["extract", "nope.aedat4"],
+        d,
+        "nope.aedat4",
+        "no such file",
+    );
+    fails(&["info", "nope.aedat4"], d, "nope.aedat4", "no such file");
+
+    std::fs::write(d.join("notes.txt"), "hello world\nthis is not events\n").unwrap();
+    fails(
+        &["extract", "notes.txt"],
+        d,
+        "notes.txt",
+        "not a supported event file",
+    );
+
+    let good = simulate(d, "good.aedat4", "20");
+    let bytes = std::fs::read(&good).unwrap();
+    // truncated in the middle of the second packet
+    let hlen = u32::from_le_bytes(bytes[14..18].try_into().unwrap()) as usize;
+    let p0 = 18 + hlen;
+    let p1 = p0 + 8 + i32::from_le_bytes(bytes[p0 + 4..p0 + 8].try_into().unwrap()) as usize;
+    std::fs::write(d.join("cut.aedat4"), &bytes[..p1 + 100]).unwrap();
+    fails(&["extract", "cut.aedat4"], d, "cut.aedat4", "truncated");
+    // a corrupt compressed packet
+    let mut bad = bytes.clone();
+    for b in &mut bad[p1 + 30..p1 + 90] {
+        *b ^= 0xa5;
+    }
+    std::fs::write(d.join("corrupt.aedat4"), &bad).unwrap();
+    fails(
+        &["extract", "corrupt.aedat4"],
+        d,
+        "corrupt.aedat4",
+        "corrupt",
+    );
+
+    // an event stream with no events
+    Aedat4Writer::create(&d.join("empty.aedat4"), Compression::Lz4, 64, 48)
+        .unwrap()
+        .finish()
+        .unwrap();
+    fails(&["extract", "empty.aedat4"], d, "empty.aedat4", "empty");
+
+    // shorter than one 16 s window
+    simulate(d, "short.aedat4", "5");
+    fails(
+        &["extract", "short.aedat4"],
+        d,
+        "short.aedat4",
+        "shorter than one",
+    );
+
+    // WAVs: noise without a mains tone, and a rate too low to carry one
+    let mut state = 0x9e3779b97f4a7c15u64;
+    let noise: Vec<f64> = (0..400 * 30)
+        .map(|_| {
+            // xorshift64*: white noise with no spectral lines
+            state ^= state >> 12;
+            state ^= state << 25;
+            state ^= state >> 27;
+            (state.wrapping_mul(0x2545f4914f6cdd1d) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        })
+        .collect();
+    eenf_cli::wav::write_wav(&d.join("noise.wav"), 400, &noise).unwrap();
+    fails(&["reference", "noise.wav"], d, "noise.wav", "no mains line");
+    fails(
+        &["reference", "--nominal", "50", "noise.wav"],
+        d,
+        "noise.wav",
+        "no 50 Hz mains line",
+    );
+    eenf_cli::wav::write_wav(&d.join("slow.wav"), 80, &noise[..2400]).unwrap();
+    fails(&["reference", "slow.wav"], d, "slow.wav", "too low");
+    std::fs::write(d.join("fake.wav"), b"RIFF\x10\x00\x00\x00WAVEjunk").unwrap();
+    fails(&["reference", "fake.wav"], d, "fake.wav", "wav");
+
+    // traces
+    std::fs::write(d.join("bad.csv"), "x,y\n1,2\n").unwrap();
+    fails(
+        &["compare", "bad.csv", "bad.csv"],
+        d,
+        "bad.csv",
+        "not a trace file",
+    );
+    std::fs::write(d.join("a.csv"), "time_s,enf_hz\n0,50\n1,50.01\n").unwrap();
+    fails(
+        &["compare", "a.csv", "a.csv", "--offset-s", "100"],
+        d,
+        "a.csv",
+        "fewer than two",
+    );
+    fails(
+        &["compare", "a.csv", "."],
+        d,
+        "a.csv",
+        "cannot tell when the recording started",
+    );
+}
+
+#[test]
+fn outputs_are_all_or_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    simulate(d, "short.aedat4", "5");
+    let (ok, _, _) = eenf(&["extract", "short.aedat4", "-o", "trace.csv"], d);
+    assert!(!ok);
+    // no partial or temporary file left behind
+    let names: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        !names
+            .iter()
+            .any(|n| n.contains("trace") || n.contains(".tmp")),
+        "{names:?}"
+    );
+}

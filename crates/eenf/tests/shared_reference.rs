@@ -1,0 +1,90 @@
+//! The reference tracker on the six real mains recordings in `../shared/enf-reference`.
+//! `#[ignore]`d (needs the shared data); `.ci/run` runs it with `--ignored`.
+
+use std::path::PathBuf;
+
+use eenf_cli::pipeline::{reference_file, Nominal};
+use eenf_dsp::{EnfParams, PeakMethod};
+
+fn shared() -> PathBuf {
+    let dir = std::env::var_os("EENF_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
+    assert!(
+        dir.join("enf-reference").is_dir(),
+        "shared data not found at {} (set EENF_SHARED)",
+        dir.display()
+    );
+    dir
+}
+
+/// A 1-D little-endian float64 .npy file.
+fn read_npy(path: &std::path::Path) -> Vec<f64> {
+    let b = std::fs::read(path).unwrap();
+    assert_eq!(&b[..6], b"\x93NUMPY");
+    let hl = u16::from_le_bytes([b[8], b[9]]) as usize;
+    let header = String::from_utf8_lossy(&b[10..10 + hl]);
+    assert!(header.contains("'<f8'"), "{header}");
+    b[10 + hl..]
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn six_real_hours_match_the_datasets_own_references() {
+    let dir = shared().join("enf-reference");
+    let mut wavs: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().map(|e| e == "wav").unwrap_or(false))
+        .collect();
+    wavs.sort();
+    assert_eq!(wavs.len(), 6);
+    for wav in &wavs {
+        let params = EnfParams {
+            peak: PeakMethod::Paper,
+            ..EnfParams::default()
+        };
+        let (f0, trace) = reference_file(wav, Nominal::Auto, &params).unwrap();
+        assert_eq!(f0, 50.0);
+        assert!(
+            trace.len() == 3601 || trace.len() == 3602,
+            "{}",
+            trace.len()
+        );
+        let n = trace.len() as f64;
+        let mean = trace.iter().sum::<f64>() / n;
+        let sd = (trace.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
+        assert!((mean - 50.0).abs() < 0.03, "{}: mean {mean}", wav.display());
+        assert!(sd > 0.012 && sd < 0.035, "{}: std {sd}", wav.display());
+        // The dataset's .npy traces come from the authors' code, whose (k + δ − 1) indexing
+        // puts every estimate fs/NFFT = 5 mHz low (method.md). With that removed they agree
+        // with ours except where two bins tie for the maximum and the biased interpolation
+        // lands ~3.7 mHz apart.
+        let authors = read_npy(&wav.with_extension("npy"));
+        assert_eq!(authors.len(), trace.len());
+        let close = trace
+            .iter()
+            .zip(&authors)
+            .filter(|(a, b)| (*a - *b - 0.005).abs() <= 1e-4)
+            .count();
+        let share = close as f64 / n;
+        println!(
+            "{}: mean {mean:.5} Hz, std {:.2} mHz, {:.2}% within 0.1 mHz of the authors' + 5 mHz",
+            wav.display(),
+            sd * 1e3,
+            share * 100.0
+        );
+        assert!(share >= 0.995, "{}: only {share}", wav.display());
+        // the exact refinement differs from the paper's by its interpolation bias only
+        let (_, exact) = reference_file(wav, Nominal::Hz(50.0), &EnfParams::default()).unwrap();
+        let worst = exact
+            .iter()
+            .zip(&trace)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 0.0025, "{}: exact vs paper {worst}", wav.display());
+    }
+}
