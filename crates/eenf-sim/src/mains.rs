@@ -178,7 +178,7 @@ impl MainsPhase {
         let mut planner = FftPlanner::new();
         planner.plan_fft_forward(n).process(&mut buf);
         for (k, c) in buf.iter_mut().enumerate() {
-            let gain = if k == 0 || (n % 2 == 0 && k == n / 2) {
+            let gain = if k == 0 || (n.is_multiple_of(2) && k == n / 2) {
                 1.0
             } else if k < n.div_ceil(2) {
                 2.0

@@ -87,6 +87,15 @@ pub struct SimStats {
     pub scans: u64,
 }
 
+/// Events of one pixel chunk over one window, in scan order: (scan in window, pixel, ON).
+#[derive(Default)]
+struct ChunkEvents {
+    scan: Vec<u16>,
+    pixel: Vec<u32>,
+    on: Vec<bool>,
+    noise: u64,
+}
+
 #[derive(Clone, Copy)]
 struct Pixel {
     level: u8,
@@ -198,7 +207,7 @@ pub fn simulate<E>(
             tables.push(log_table(lamp));
         }
         let seeds: Vec<u64> = (0..(w * h).div_ceil(chunk_px)).map(|_| rng.gen()).collect();
-        let outputs: Vec<(Vec<u16>, Vec<u32>, Vec<bool>, u64)> = pixels
+        let outputs: Vec<ChunkEvents> = pixels
             .par_chunks_mut(chunk_px)
             .zip(seeds)
             .enumerate()
@@ -222,7 +231,10 @@ pub fn simulate<E>(
                     .collect();
                 noise.sort_unstable();
                 let mut ni = 0;
-                let (mut steps, mut pix, mut pol) = (Vec::new(), Vec::new(), Vec::new());
+                let mut out = ChunkEvents {
+                    noise: count as u64,
+                    ..ChunkEvents::default()
+                };
                 let base = (ci * chunk_px) as u32;
                 for (s, table) in tables.iter().enumerate() {
                     let scan = (scan0 + s) as u32;
@@ -236,15 +248,15 @@ pub fn simulate<E>(
                             let on = d > 0.0;
                             px.reference += if on { px.c_on } else { -px.c_off };
                             px.ready_at = scan + refractory_scans;
-                            steps.push(s as u16);
-                            pix.push(base + i as u32);
-                            pol.push(on);
+                            out.scan.push(s as u16);
+                            out.pixel.push(base + i as u32);
+                            out.on.push(on);
                         } else if noisy {
                             let on = noise[ni].2;
                             px.reference += if on { px.c_on } else { -px.c_off };
-                            steps.push(s as u16);
-                            pix.push(base + i as u32);
-                            pol.push(on);
+                            out.scan.push(s as u16);
+                            out.pixel.push(base + i as u32);
+                            out.on.push(on);
                         }
                         while ni < noise.len()
                             && noise[ni].0 as usize == s
@@ -254,7 +266,7 @@ pub fn simulate<E>(
                         }
                     }
                 }
-                (steps, pix, pol, count as u64)
+                out
             })
             .collect();
         // merge the chunks scan by scan (chunks are in row-major pixel order)
@@ -262,19 +274,19 @@ pub fn simulate<E>(
         let mut ptr = vec![0usize; outputs.len()];
         for (s, &t_us) in times.iter().enumerate() {
             for (c, out) in outputs.iter().enumerate() {
-                while ptr[c] < out.0.len() && out.0[ptr[c]] as usize == s {
-                    let p = out.1[ptr[c]] as usize;
+                while ptr[c] < out.scan.len() && out.scan[ptr[c]] as usize == s {
+                    let p = out.pixel[ptr[c]] as usize;
                     batch.push(
                         config.start_us + t_us,
                         (p % w) as u16,
                         (p / w) as u16,
-                        out.2[ptr[c]],
+                        out.on[ptr[c]],
                     );
                     ptr[c] += 1;
                 }
             }
         }
-        stats.noise_events += outputs.iter().map(|o| o.3).sum::<u64>();
+        stats.noise_events += outputs.iter().map(|o| o.noise).sum::<u64>();
         stats.events += batch.len() as u64;
         stats.on_events += batch.p.iter().filter(|&&p| p).count() as u64;
         stats.scans += n as u64;

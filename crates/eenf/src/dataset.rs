@@ -39,7 +39,7 @@ pub fn recording_start(path: &Path) -> Option<StartTime> {
     let name = path.file_name()?.to_str()?;
     let i = name.find("dvSave-")?;
     let digits: Vec<u32> = name[i + 7..]
-        .split(|c: char| c == '_' || c == '.' || c == '-')
+        .split(['_', '.', '-'])
         .take(6)
         .map(|s| s.parse().ok())
         .collect::<Option<Vec<u32>>>()?;

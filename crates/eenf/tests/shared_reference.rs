@@ -78,13 +78,61 @@ fn six_real_hours_match_the_datasets_own_references() {
             share * 100.0
         );
         assert!(share >= 0.995, "{}: only {share}", wav.display());
-        // the exact refinement differs from the paper's by its interpolation bias only
+        // the exact refinement differs from the paper's by the interpolation bias: about a
+        // millisecond-hertz on average, a few at worst where the ENF moves within the window
         let (_, exact) = reference_file(wav, Nominal::Hz(50.0), &EnfParams::default()).unwrap();
-        let worst = exact
+        let diffs: Vec<f64> = exact
             .iter()
             .zip(&trace)
             .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        assert!(worst < 0.0025, "{}: exact vs paper {worst}", wav.display());
+            .collect();
+        let worst = diffs.iter().copied().fold(0.0, f64::max);
+        let mean = diffs.iter().sum::<f64>() / n;
+        println!(
+            "  exact vs paper: mean {:.3} mHz, max {:.3} mHz",
+            mean * 1e3,
+            worst * 1e3
+        );
+        assert!(
+            mean < 0.001 && worst < 0.005,
+            "{}: exact vs paper mean {mean} max {worst}",
+            wav.display()
+        );
     }
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn simulation_driven_by_a_real_hour_is_recovered() {
+    use eenf_cli::pipeline::{extract_file, ExtractOptions};
+    use eenf_cli::progress::Progress;
+    use eenf_events::{Aedat4Writer, Compression};
+    use eenf_sim::{simulate, MainsPhase, SimConfig};
+
+    let wav = shared().join("enf-reference/2022_08_17_Wed_16_00_00.wav");
+    let sig = eenf_cli::wav::read_wav(&wav).unwrap();
+    let start = 600.0;
+    let config = SimConfig {
+        duration_s: 120.0,
+        ..SimConfig::default()
+    };
+    let mains =
+        MainsPhase::from_recording(&sig.samples, sig.fs, 50.0, start, config.duration_s).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let rec = tmp.path().join("wav600.aedat4");
+    let mut w = Aedat4Writer::create(&rec, Compression::Lz4, config.width, config.height).unwrap();
+    simulate(&config, &mains, |b| w.write(b)).unwrap();
+    w.finish().unwrap();
+    let x = extract_file(&rec, &ExtractOptions::default(), &Progress::hidden()).unwrap();
+    assert_eq!(x.params.nominal_hz, 50.0);
+    // against the simulator's truth
+    let truth = mains.truth(config.duration_s);
+    let m = eenf_dsp::agreement(&x.trace.enf_hz, &truth).unwrap();
+    println!("vs truth: {m:?}");
+    assert!(m.n >= 120 && m.cc >= 0.95 && m.mae_hz <= 0.002, "{m:?}");
+    // and against the real hour's own reference trace, 600 s in
+    let (_, reference) = reference_file(&wav, Nominal::Hz(50.0), &EnfParams::default()).unwrap();
+    let m = eenf_dsp::agreement(&x.trace.enf_hz, &reference[600..]).unwrap();
+    println!("vs the WAV's reference at 600 s: {m:?}");
+    assert!(m.cc >= 0.95 && m.mae_hz <= 0.002, "{m:?}");
 }
