@@ -20,7 +20,11 @@
 pub mod aedat4;
 mod batch;
 mod error;
+pub mod jaer;
+pub mod prophesee;
+mod stream;
 pub mod text;
+pub mod writers;
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -31,7 +35,7 @@ pub use error::{EventError, Result};
 pub use text::TextReader;
 
 /// The formats this version reads, for error messages.
-pub const SUPPORTED: &str = "AEDAT 4.0 (.aedat4), text (t x y p)";
+pub const SUPPORTED: &str = "AEDAT 4.0 (.aedat4), Prophesee EVT 2.0/2.1/3.0 (.raw) and DAT (.dat), jAER AEDAT 2.0/3.1 (.aedat), text (t x y p)";
 
 /// One data stream declared by a file (AEDAT4 files can carry events, frames, IMU, triggers).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -78,6 +82,10 @@ pub trait EventReader: Send {
     /// The next batch of events, `None` at the end. Events before damage are delivered before
     /// the error that reports it.
     fn next_batch(&mut self) -> Result<Option<EventBatch>>;
+    /// Words or packets read so far that were not events (triggers, IMU, APS…), by kind.
+    fn skipped(&self) -> Vec<(&'static str, u64)> {
+        Vec::new()
+    }
 }
 
 /// The formats eenf recognises by content.
@@ -85,6 +93,12 @@ pub trait EventReader: Send {
 pub enum Format {
     /// iniVation AEDAT 4.0.
     Aedat4,
+    /// Prophesee RAW or DAT (the encoding is in the `% ` header).
+    Prophesee(prophesee::ProphFormat),
+    /// jAER AEDAT 2.0.
+    Aedat2,
+    /// jAER AEDAT 3.1.
+    Aedat31,
     /// Plain text `t x y p`.
     Text,
 }
@@ -113,12 +127,25 @@ pub fn probe(path: &Path) -> Result<Format> {
     if head.starts_with(aedat4::MAGIC) {
         return Ok(Format::Aedat4);
     }
-    let later = |name: &str| unknown(format!("{name} is recognised but not readable yet"));
-    if head.starts_with(b"#!AER-DAT2.0") || head.starts_with(b"#!AER-DAT3") {
-        return Err(later("jAER AEDAT 2.0/3.x"));
+    if head.starts_with(b"#!AER-DAT2.0") {
+        return Ok(Format::Aedat2);
     }
-    if head.starts_with(b"% ") {
-        return Err(later("Prophesee RAW/DAT"));
+    if head.starts_with(b"#!AER-DAT3") {
+        return Ok(Format::Aedat31);
+    }
+    if head.starts_with(b"%") {
+        let header = stream::read_text_header(path, b"%", None, "Prophesee")?;
+        if let Some(kind) = prophesee::format_from_header(&header.lines) {
+            return Ok(Format::Prophesee(kind));
+        }
+        // a DAT header may name nothing; its data starts with type 0 and size 8
+        let at = header.data_start as usize;
+        if head.get(at..at + 2) == Some(&[0, 8]) {
+            return Ok(Format::Prophesee(prophesee::ProphFormat::Dat));
+        }
+        return Err(unknown(
+            "a % header that names no EVT encoding or DAT version".into(),
+        ));
     }
     // Text: the first event line (after comments) holds four numbers. Judge only complete lines.
     let text = String::from_utf8_lossy(&head);
@@ -153,6 +180,9 @@ pub fn probe(path: &Path) -> Result<Format> {
 pub fn open(path: &Path) -> Result<Box<dyn EventReader>> {
     Ok(match probe(path)? {
         Format::Aedat4 => Box::new(Aedat4Reader::open(path)?),
+        Format::Prophesee(_) => prophesee::open(path)?,
+        Format::Aedat2 => jaer::open_aedat2(path)?,
+        Format::Aedat31 => jaer::open_aedat31(path)?,
         Format::Text => Box::new(TextReader::open(path)?),
     })
 }

@@ -5,7 +5,7 @@
 //! polarity 0/1 or -1/+1.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
 use crate::error::{io_err, EventError, Result};
@@ -181,34 +181,6 @@ impl EventReader for TextReader {
             }
         }
         Ok(if batch.is_empty() { None } else { Some(batch) })
-    }
-}
-
-/// Writes events as text, `t x y p` with integer microseconds and polarity 0/1.
-pub fn write_text(path: &Path, batches: impl IntoIterator<Item = EventBatch>) -> Result<u64> {
-    let tmp = crate::tmp_path_for(path);
-    let res = (|| -> std::io::Result<u64> {
-        let mut w = std::io::BufWriter::new(File::create(&tmp)?);
-        writeln!(w, "# t_us x y p")?;
-        let mut n = 0;
-        for b in batches {
-            for i in 0..b.len() {
-                writeln!(w, "{} {} {} {}", b.t[i], b.x[i], b.y[i], b.p[i] as u8)?;
-            }
-            n += b.len() as u64;
-        }
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        Ok(n)
-    })();
-    match res {
-        Ok(n) => {
-            std::fs::rename(&tmp, path).map_err(|e| io_err(path, e))?;
-            Ok(n)
-        }
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(io_err(path, e))
-        }
     }
 }
 

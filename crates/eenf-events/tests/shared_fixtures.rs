@@ -78,3 +78,158 @@ fn real_dvxplorer_aedat4_matches_dv_processing() {
     assert_eq!(s.y_range, Some((0, 239)));
     assert_eq!(s.on, 55_023);
 }
+
+/// Sorts events within each timestamp, for formats that may reorder events sharing one.
+fn canonical(b: &EventBatch) -> Vec<(i64, u16, u16, bool)> {
+    let mut v: Vec<_> = (0..b.len())
+        .map(|i| (b.t[i], b.x[i], b.y[i], b.p[i]))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn every_synthetic_format_equals_truth() {
+    let truth = truth();
+    for (name, format, reorders) in [
+        ("synth_evt2.raw", "EVT 2.0", false),
+        ("synth_evt21_little.raw", "EVT 2.1", false),
+        ("synth_evt21_legacy.raw", "EVT 2.1", false),
+        ("synth_evt3.raw", "EVT 3.0", true),
+        ("synth_dat.dat", "DAT", false),
+        ("synth_aedat2.aedat", "AEDAT 2.0", false),
+        ("synth_aedat31.aedat", "AEDAT 3.1", false),
+    ] {
+        let path = shared().join("fixtures/synthetic").join(name);
+        let r = open(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(r.info().format, format, "{name}");
+        let got = read_all(&path);
+        assert_eq!(got.len(), truth.len(), "{name}: count");
+        if reorders {
+            assert_eq!(canonical(&got), canonical(&truth), "{name}");
+        } else {
+            assert_eq!(got.t, truth.t, "{name}: t");
+            assert_eq!(got.x, truth.x, "{name}: x");
+            assert_eq!(got.y, truth.y, "{name}: y");
+            assert_eq!(got.p, truth.p, "{name}: p");
+        }
+    }
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn real_prophesee_files_match_the_reference_decoders() {
+    type Expect = (&'static str, u64, i64, i64, (u16, u16), (u16, u16), u64);
+    let cases: [Expect; 4] = [
+        (
+            "expelliarmus_evt2_sample.raw",
+            539_481,
+            1_317_888,
+            1_367_888,
+            (60, 599),
+            (18, 475),
+            367_855,
+        ),
+        (
+            "faery_evt2.raw",
+            521_252,
+            913_716_224,
+            913_812_095,
+            (0, 639),
+            (0, 479),
+            185_861,
+        ),
+        (
+            "expelliarmus_evt3_sample.raw",
+            219_596,
+            11_718_656,
+            11_727_457,
+            (0, 1279),
+            (0, 719),
+            115_532,
+        ),
+        (
+            "tonic_sample_ncars.dat",
+            2_009,
+            0,
+            99_952,
+            (0, 77),
+            (0, 41),
+            1_350,
+        ),
+    ];
+    for (name, n, first, last, xr, yr, on) in cases {
+        let path = shared().join("fixtures/real").join(name);
+        let mut r = open(&path).unwrap_or_else(|e| panic!("{e}"));
+        let s = StreamStats::scan(r.as_mut()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.events, n, "{name}: count");
+        assert_eq!(
+            (s.first_t, s.last_t),
+            (Some(first), Some(last)),
+            "{name}: time span"
+        );
+        assert_eq!(
+            (s.x_range, s.y_range),
+            (Some(xr), Some(yr)),
+            "{name}: ranges"
+        );
+        assert_eq!(s.on, on, "{name}: ON events");
+    }
+    // geometry from the sensor generation when the header has none
+    let r = open(&shared().join("fixtures/real/expelliarmus_evt3_sample.raw")).unwrap();
+    assert_eq!((r.info().width, r.info().height), (Some(1280), Some(720)));
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn every_fixture_survives_truncation_and_bit_flips() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut files = Vec::new();
+    for sub in ["synthetic", "real"] {
+        for e in std::fs::read_dir(shared().join("fixtures").join(sub)).unwrap() {
+            let p = e.unwrap().path();
+            if p.extension().map(|e| e != "csv").unwrap_or(false) {
+                files.push(p);
+            }
+        }
+    }
+    assert!(files.len() >= 18, "{files:?}");
+    for path in files {
+        let bytes = std::fs::read(&path).unwrap();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let damaged = dir.path().join(&name);
+        let read = |p: &std::path::Path| -> usize {
+            let Ok(mut r) = open(p) else { return 0 };
+            let mut n = 0;
+            while let Ok(Some(b)) = r.next_batch() {
+                n += b.len();
+            }
+            n
+        };
+        let whole = read(&path);
+        let cuts: Vec<usize> = (0..400.min(bytes.len()))
+            .chain((400..bytes.len()).step_by(bytes.len() / 61 + 1))
+            .collect();
+        for cut in cuts {
+            std::fs::write(&damaged, &bytes[..cut]).unwrap();
+            assert!(
+                read(&damaged) <= whole,
+                "{name} cut at {cut} gave more events"
+            );
+        }
+        let mut s = 7u64;
+        for _ in 0..60 {
+            let mut b = bytes.clone();
+            for _ in 0..3 {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let at = (s >> 33) as usize % b.len();
+                b[at] ^= 1 << ((s >> 29) & 7);
+            }
+            std::fs::write(&damaged, &b).unwrap();
+            let _ = read(&damaged);
+        }
+    }
+}

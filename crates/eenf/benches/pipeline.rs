@@ -9,23 +9,30 @@ use std::path::PathBuf;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use eenf_cli::pipeline::{extract_file, ExtractOptions, Nominal};
 use eenf_cli::progress::Progress;
-use eenf_events::{Aedat4Writer, Compression, EventBatch};
+use eenf_events::writers::{create, OutputFormat};
+use eenf_events::{Compression, EventBatch};
 
 const RATE: u64 = 2_000_000;
 const SCAN_US: i64 = 200;
 
-/// Writes (once) a flicker recording of `seconds` with the given codec; returns its path and
-/// event count.
-fn fixture(seconds: u64, codec: Compression) -> (PathBuf, u64) {
+/// Writes (once) a flicker recording of `seconds` in `format`; returns its path and event count.
+fn fixture(seconds: u64, format: OutputFormat) -> (PathBuf, u64) {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
-    let path = dir.join(format!("bench-{seconds}s-{}.aedat4", codec.name()));
+    let name = match format {
+        OutputFormat::Aedat4(c) => format!("bench-{seconds}s-{}.aedat4", c.name()),
+        OutputFormat::Evt2 => format!("bench-{seconds}s-evt2.raw"),
+        OutputFormat::Evt3 => format!("bench-{seconds}s-evt3.raw"),
+        OutputFormat::Dat => format!("bench-{seconds}s.dat"),
+        OutputFormat::Text => format!("bench-{seconds}s.txt"),
+    };
+    let path = dir.join(name);
     let per_scan = (RATE * SCAN_US as u64 / 1_000_000) as usize;
     let scans = seconds * 1_000_000 / SCAN_US as u64;
     let total = scans * per_scan as u64;
     if path.exists() {
         return (path, total);
     }
-    let mut w = Aedat4Writer::create(&path, codec, 640, 480).unwrap();
+    let mut w = create(&path, format, 640, 480).unwrap();
     let mut state = 0x2545f4914f6cdd1du64;
     let mut next = || {
         state ^= state >> 12;
@@ -63,9 +70,15 @@ fn benches(c: &mut Criterion) {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(20);
-    for codec in [Compression::Lz4, Compression::Zstd] {
-        let (path, n) = fixture(seconds, codec);
-        let mut g = c.benchmark_group(format!("aedat4_{}", codec.name()));
+    for format in [
+        OutputFormat::Aedat4(Compression::Lz4),
+        OutputFormat::Aedat4(Compression::Zstd),
+        OutputFormat::Evt2,
+        OutputFormat::Evt3,
+        OutputFormat::Dat,
+    ] {
+        let (path, n) = fixture(seconds, format);
+        let mut g = c.benchmark_group(format.name().replace(' ', "_"));
         g.sample_size(10);
         g.throughput(Throughput::Elements(n));
         g.bench_function("decode", |b| {
@@ -78,7 +91,7 @@ fn benches(c: &mut Criterion) {
                 assert_eq!(count as u64, n);
             })
         });
-        if codec == Compression::Lz4 {
+        if format == OutputFormat::Aedat4(Compression::Lz4) {
             let opts = ExtractOptions {
                 nominal: Nominal::Hz(50.0),
                 ..ExtractOptions::default()

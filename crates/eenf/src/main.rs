@@ -25,6 +25,8 @@ struct Cli {
 enum Command {
     /// Show what an event file holds: format, codec, resolution, streams, events, time span.
     Info(commands::info::Args),
+    /// Convert an event file to another format (AEDAT4, EVT 2.0, EVT 3.0, DAT, text).
+    Convert(commands::convert::Args),
     /// Extract the ENF trace from an event recording (E-ENF).
     Extract(commands::extract::Args),
     /// Build the reference ENF trace from a mains/audio WAV recording.
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
     let progress = eenf_cli::progress::Progress::new(cli.quiet);
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),
+        Command::Convert(a) => commands::convert::run(a, progress),
         Command::Extract(a) => commands::extract::run(a, progress),
         Command::Reference(a) => commands::reference::run(a, progress),
         Command::Compare(a) => commands::compare::run(a, progress),

@@ -42,6 +42,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             resolution: "64x48".into(),
             seed: a.seed,
             compression: "lz4".into(),
+            format: None,
         },
         progress,
     )?;

@@ -20,6 +20,7 @@ pub fn run(a: Args) -> Result<()> {
     let mut reader = eenf_events::open(&a.file)?;
     let info = reader.info().clone();
     let stats = StreamStats::scan(reader.as_mut())?;
+    let skipped = reader.skipped();
     let duration_s = match (stats.first_t, stats.last_t) {
         (Some(f), Some(l)) => (l - f) as f64 * 1e-6,
         _ => 0.0,
@@ -48,6 +49,7 @@ pub fn run(a: Args) -> Result<()> {
             "first_t_us": stats.first_t, "last_t_us": stats.last_t,
             "duration_s": duration_s, "events_per_s": rate,
             "x_range": stats.x_range, "y_range": stats.y_range,
+            "skipped": skipped.iter().map(|(k, n)| (k.to_string(), *n)).collect::<std::collections::BTreeMap<_, _>>(),
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());

@@ -1,6 +1,7 @@
 //! One module per command.
 
 pub mod compare;
+pub mod convert;
 pub mod demo;
 pub mod extract;
 pub mod info;

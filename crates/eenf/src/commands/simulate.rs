@@ -7,7 +7,8 @@ use eenf_cli::output::{times, write_atomic, write_trace_csv};
 use eenf_cli::pipeline::{mains_nominal, Nominal};
 use eenf_cli::progress::Progress;
 use eenf_cli::wav::read_wav;
-use eenf_events::{Aedat4Writer, Compression};
+use eenf_events::writers::{create, OutputFormat};
+use eenf_events::Compression;
 use eenf_sim::{simulate, MainsPhase, SimConfig, SimStats, SyntheticEnf};
 
 /// Arguments of `eenf simulate`.
@@ -23,8 +24,9 @@ pub struct Args {
     /// Grid frequency of a synthetic ENF: 50 or 60 (a WAV's own is detected).
     #[arg(long, default_value_t = 50)]
     pub grid: u32,
-    /// Output recording: AEDAT4, or text (`t x y p`) when the name ends in .txt.
-    /// The truth goes beside it as NAME.truth.csv, the parameters as NAME.sim.json.
+    /// Output recording; the format follows the extension (.aedat4, .raw = EVT 3.0, .dat,
+    /// .txt) unless --format says. The truth goes beside it as NAME.truth.csv, the parameters
+    /// as NAME.sim.json.
     #[arg(short, long, default_value = "simulated.aedat4")]
     pub output: PathBuf,
     /// Sensor resolution WxH.
@@ -36,6 +38,9 @@ pub struct Args {
     /// AEDAT4 packet compression: none, lz4, lz4_high, zstd, zstd_high.
     #[arg(long, default_value = "lz4")]
     pub compression: String,
+    /// Output format: aedat4, evt2, evt3, dat, text (default: from the extension).
+    #[arg(long)]
+    pub format: Option<String>,
 }
 
 /// Paths and numbers of a finished simulation.
@@ -120,25 +125,19 @@ pub fn run(a: Args, progress: Progress) -> Result<Simulated> {
         (a.duration * 1e6 / config.scan_period_us as f64) as u64,
         "simulating",
     );
-    let text = a.output.extension().and_then(|e| e.to_str()) == Some("txt");
-    let stats = if text {
-        let mut all = Vec::new();
-        let stats = simulate(&config, &mains, |b| {
-            bar.inc(250);
-            all.push(b.clone());
-            Ok::<_, anyhow::Error>(())
-        })?;
-        eenf_events::text::write_text(&a.output, all)?;
-        stats
-    } else {
-        let mut writer = Aedat4Writer::create(&a.output, codec, width, height)?;
-        let stats = simulate(&config, &mains, |b| {
-            bar.inc(250);
-            writer.write(b).map_err(anyhow::Error::from)
-        })?;
-        writer.finish()?;
-        stats
+    let format = match &a.format {
+        Some(f) => OutputFormat::parse(f, codec)
+            .with_context(|| format!("--format {f:?}: expected aedat4, evt2, evt3, dat or text"))?,
+        None => {
+            OutputFormat::from_extension(&a.output, codec).unwrap_or(OutputFormat::Aedat4(codec))
+        }
     };
+    let mut writer = create(&a.output, format, width, height)?;
+    let stats = simulate(&config, &mains, |b| {
+        bar.inc(250);
+        writer.write(b).map_err(anyhow::Error::from)
+    })?;
+    writer.finish()?;
     bar.finish_and_clear();
     let truth = mains.truth(a.duration);
     let truth_path = sibling(&a.output, "truth.csv");

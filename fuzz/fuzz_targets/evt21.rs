@@ -1,0 +1,9 @@
+#![no_main]
+//! Fuzz target: the evt21 reader.
+
+#[path = "common.rs"]
+mod common;
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    common::read_with_header(b"% evt 2.1\n% end\n", data, "raw");
+});

@@ -1,0 +1,9 @@
+#![no_main]
+//! Fuzz target: the probe reader.
+
+#[path = "common.rs"]
+mod common;
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    common::read_with_header(b"", data, "bin");
+});
