@@ -20,6 +20,7 @@
 pub mod butter;
 pub mod enf;
 pub mod filtfilt;
+pub mod matching;
 pub mod metrics;
 pub mod postprocess;
 pub mod sampling;

@@ -1,0 +1,592 @@
+//! Placing an ENF trace in time: normalised cross-correlation against a long reference at every
+//! offset, with a significance that accounts for the trace's length and autocorrelation.
+
+use std::sync::Arc;
+
+use rayon::prelude::*;
+use realfft::num_complex::Complex64;
+use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
+
+/// How matching is done.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct MatchOptions {
+    /// Candidates to report.
+    pub top: usize,
+    /// Offsets closer than this (in steps) to a better candidate are not reported.
+    pub exclusion: usize,
+    /// Least share of the trace that must overlap valid reference values.
+    pub min_overlap: f64,
+    /// What ranks offsets and sets the significance.
+    pub score: Score,
+}
+
+/// The statistic that ranks offsets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Score {
+    /// atanh(CC) − ln(RMSE): shape and level together. A clip from another time often has some
+    /// window of similar shape (CC ≈ 0.99) but rarely one at the same frequency level too.
+    Combined,
+    /// Normalised cross-correlation alone (shape only; robust to a constant bias).
+    Cc,
+}
+
+impl Default for MatchOptions {
+    fn default() -> Self {
+        MatchOptions {
+            top: 5,
+            exclusion: 60,
+            min_overlap: 0.8,
+            score: Score::Combined,
+        }
+    }
+}
+
+/// One place where the trace fits.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Candidate {
+    /// Offset of the trace's first value in the reference, in steps (fractional after
+    /// refinement of the correlation peak).
+    pub offset: f64,
+    /// Pearson correlation at the integer offset.
+    pub cc: f64,
+    /// Mean absolute difference at the integer offset, Hz.
+    pub mae_hz: f64,
+    /// Root-mean-square difference at the integer offset, Hz.
+    pub rmse_hz: f64,
+    /// Values compared.
+    pub overlap: usize,
+    /// Probability that the best of all offsets of unrelated data scores this well.
+    pub p_value: f64,
+}
+
+/// The outcome of a search.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MatchResult {
+    /// Best candidates, best first.
+    pub candidates: Vec<Candidate>,
+    /// Offsets scored.
+    pub offsets: usize,
+    /// Offsets over which scores stay correlated (from their autocorrelation).
+    pub score_corr_len: f64,
+    /// Blocks whose maxima calibrate the significance, and their length in offsets.
+    pub null_blocks: usize,
+    /// See `null_blocks`.
+    pub block_len: usize,
+    /// The tail of the null: the k-th largest block maximum `tail_u` and the mean excess over
+    /// it `tail_beta` of the k − 1 above it (an exponential tail).
+    pub tail_u: f64,
+    /// See `tail_u`.
+    pub tail_beta: f64,
+    /// See `tail_u`.
+    pub tail_k: usize,
+}
+
+/// The significance threshold that `eenf match` calls a match.
+pub const DEFAULT_ALPHA: f64 = 1e-3;
+
+/// Why matching could not be done.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum MatchError {
+    /// The trace is too short or too empty.
+    #[error("the trace has {0} usable values; at least 10 are needed")]
+    TooShort(usize),
+    /// The reference is shorter than the trace.
+    #[error("the reference ({reference} values) is shorter than the trace ({trace})")]
+    ReferenceTooShort {
+        /// Reference length.
+        reference: usize,
+        /// Trace length.
+        trace: usize,
+    },
+    /// The trace does not vary at all.
+    #[error("the trace is constant: it cannot be placed in time")]
+    Flat,
+}
+
+/// Fills NaN gaps of a trace by linear interpolation (ends by the nearest value).
+pub fn fill_gaps(x: &[f64]) -> Vec<f64> {
+    let mut out = x.to_vec();
+    let valid: Vec<usize> = (0..x.len()).filter(|&i| x[i].is_finite()).collect();
+    if valid.is_empty() {
+        return out;
+    }
+    for i in 0..x.len() {
+        if x[i].is_finite() {
+            continue;
+        }
+        let next = valid.partition_point(|&v| v < i);
+        out[i] = match (next.checked_sub(1).map(|p| valid[p]), valid.get(next)) {
+            (Some(a), Some(&b)) => x[a] + (x[b] - x[a]) * (i - a) as f64 / (b - a) as f64,
+            (Some(a), None) => x[a],
+            (None, Some(&b)) => x[b],
+            (None, None) => f64::NAN,
+        };
+    }
+    out
+}
+
+/// Resamples a trace from `from_step` to `to_step` seconds (linear interpolation).
+pub fn resample(x: &[f64], from_step: f64, to_step: f64) -> Vec<f64> {
+    if (from_step - to_step).abs() < 1e-9 || x.len() < 2 {
+        return x.to_vec();
+    }
+    let span = (x.len() - 1) as f64 * from_step;
+    let n = (span / to_step).floor() as usize + 1;
+    (0..n)
+        .map(|j| {
+            let pos = j as f64 * to_step / from_step;
+            let i = (pos.floor() as usize).min(x.len() - 2);
+            let w = pos - i as f64;
+            x[i] * (1.0 - w) + x[i + 1] * w
+        })
+        .collect()
+}
+
+/// Pearson CC, MAE and RMSE of `q` against `r[k..k + q.len()]` over the values valid in both.
+fn score_at(q: &[f64], r: &[f64], k: usize) -> (f64, f64, f64, usize) {
+    let (mut n, mut sq, mut sr, mut sqq, mut srr, mut sqr, mut abs, mut sq_err) =
+        (0usize, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for (a, b) in q.iter().zip(&r[k..k + q.len()]) {
+        if a.is_finite() && b.is_finite() {
+            n += 1;
+            sq += a;
+            sr += b;
+            sqq += a * a;
+            srr += b * b;
+            sqr += a * b;
+            abs += (a - b).abs();
+            sq_err += (a - b) * (a - b);
+        }
+    }
+    if n < 3 {
+        return (f64::NAN, f64::NAN, f64::NAN, n);
+    }
+    let nf = n as f64;
+    let cov = sqr - sq * sr / nf;
+    let den = ((sqq - sq * sq / nf) * (srr - sr * sr / nf)).sqrt();
+    let cc = if den > 0.0 { cov / den } else { f64::NAN };
+    (cc, abs / nf, (sq_err / nf).sqrt(), n)
+}
+
+/// The ranking statistic from CC and RMSE.
+fn statistic(score: Score, cc: f64, rmse: f64) -> f64 {
+    let z = cc.clamp(-0.999_999, 0.999_999).atanh();
+    match score {
+        Score::Cc => z,
+        // 1 µHz floor: an exact copy does not make the score infinite
+        Score::Combined => z - rmse.max(1e-6).ln(),
+    }
+}
+
+/// CC and RMSE of `q` (no gaps; zero mean, `q_mean` added back for the RMSE) against every
+/// window of `r` (NaN = gap), by overlap-save FFT blocks and running sums; windows with gaps are
+/// scored directly. Returns (cc, rmse) per offset.
+fn scores_all(q: &[f64], q_mean: f64, r: &[f64], min_valid: usize) -> (Vec<f32>, Vec<f32>) {
+    let m = q.len();
+    let n_off = r.len() - m + 1;
+    let block = (4 * m).next_power_of_two().max(1 << 16);
+    let hop = block - m + 1;
+    let mut planner = RealFftPlanner::<f64>::new();
+    let fwd: Arc<dyn RealToComplex<f64>> = planner.plan_fft_forward(block);
+    let inv: Arc<dyn ComplexToReal<f64>> = planner.plan_fft_inverse(block);
+    let mut qbuf = vec![0.0; block];
+    qbuf[..m].copy_from_slice(q);
+    let mut qspec = fwd.make_output_vec();
+    fwd.process(&mut qbuf, &mut qspec).expect("sized by plan");
+    let qspec: Vec<Complex64> = qspec.iter().map(|c| c.conj() / block as f64).collect();
+    let q_norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+    // Σ (q + q_mean)² for the RMSE
+    let q_abs_sq = q.iter().map(|v| (v + q_mean) * (v + q_mean)).sum::<f64>();
+    let mut out = vec![f32::NAN; n_off];
+    let mut rmse = vec![f32::NAN; n_off];
+    let full = |q: &[f64]| -> Vec<f64> { q.iter().map(|v| v + q_mean).collect() };
+    let q_full = full(q);
+    out.par_chunks_mut(hop)
+        .zip(rmse.par_chunks_mut(hop))
+        .enumerate()
+        .for_each_init(
+            || {
+                (
+                    fwd.make_input_vec(),
+                    fwd.make_output_vec(),
+                    fwd.make_scratch_vec(),
+                    inv.make_scratch_vec(),
+                )
+            },
+            |(buf, spec, s1, s2), (bi, (dst, dst_rmse))| {
+                let start = bi * hop;
+                let end = (start + block).min(r.len());
+                let seg = &r[start..end];
+                // gaps count as zero in the FFT; their windows are redone below
+                for (d, s) in buf
+                    .iter_mut()
+                    .zip(seg.iter().chain(std::iter::repeat(&0.0)))
+                {
+                    *d = if s.is_finite() { *s } else { 0.0 };
+                }
+                fwd.process_with_scratch(buf, spec, s1)
+                    .expect("sized by plan");
+                for (a, b) in spec.iter_mut().zip(&qspec) {
+                    *a *= b;
+                }
+                inv.process_with_scratch(spec, buf, s2)
+                    .expect("sized by plan");
+                // running window sums of r, r² and the gap count
+                let (mut s, mut ss, mut gaps) = (0.0f64, 0.0f64, 0usize);
+                let value = |i: usize| seg.get(i).copied().unwrap_or(f64::NAN);
+                for v in (0..m).map(value) {
+                    if v.is_finite() {
+                        s += v;
+                        ss += v * v;
+                    } else {
+                        gaps += 1;
+                    }
+                }
+                for (k, o) in dst.iter_mut().enumerate() {
+                    if k > 0 {
+                        let (old, new) = (value(k - 1), value(k + m - 1));
+                        if old.is_finite() {
+                            s -= old;
+                            ss -= old * old;
+                        } else {
+                            gaps -= 1;
+                        }
+                        if new.is_finite() {
+                            s += new;
+                            ss += new * new;
+                        } else {
+                            gaps += 1;
+                        }
+                    }
+                    let (cc, e) = if gaps == 0 {
+                        let var = ss - s * s / m as f64;
+                        let cc = if var > 0.0 {
+                            buf[k] / (q_norm * var.sqrt())
+                        } else {
+                            f64::NAN
+                        };
+                        // Σ(q − r)² = Σq² − 2Σq·r + Σr², with Σq·r = Σ(q − q̄)·r + q̄·Σr
+                        let sse = q_abs_sq - 2.0 * (buf[k] + q_mean * s) + ss;
+                        (cc, (sse.max(0.0) / m as f64).sqrt())
+                    } else if m - gaps >= min_valid {
+                        let (cc, _, e, _) = score_at(&q_full, r, start + k);
+                        (cc, e)
+                    } else {
+                        (f64::NAN, f64::NAN)
+                    };
+                    *o = cc as f32;
+                    dst_rmse[k] = e as f32;
+                }
+            },
+        );
+    (out, rmse)
+}
+
+/// Finds where `trace` (step-aligned with `reference`, NaN = missing) best fits in
+/// `reference` (NaN = gap).
+pub fn match_trace(
+    trace: &[f64],
+    reference: &[f64],
+    opts: &MatchOptions,
+) -> Result<MatchResult, MatchError> {
+    let usable = trace.iter().filter(|v| v.is_finite()).count();
+    if usable < 10 {
+        return Err(MatchError::TooShort(usable));
+    }
+    if reference.len() < trace.len() {
+        return Err(MatchError::ReferenceTooShort {
+            reference: reference.len(),
+            trace: trace.len(),
+        });
+    }
+    let filled = fill_gaps(trace);
+    let mean = filled.iter().sum::<f64>() / filled.len() as f64;
+    let q: Vec<f64> = filled.iter().map(|v| v - mean).collect();
+    if q.iter().all(|v| v.abs() < 1e-12) {
+        return Err(MatchError::Flat);
+    }
+    let min_valid = ((opts.min_overlap * trace.len() as f64).ceil() as usize).max(3);
+    // deviations from the reference's own mean keep the running sums well conditioned
+    let r_mean = {
+        let (s, n) = reference
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+        if n > 0 {
+            s / n as f64
+        } else {
+            0.0
+        }
+    };
+    let r: Vec<f64> = reference.iter().map(|v| v - r_mean).collect();
+    let (cc_all, rmse_all) = scores_all(&q, mean - r_mean, &r, min_valid);
+    let cc: Vec<f32> = cc_all
+        .iter()
+        .zip(&rmse_all)
+        .map(|(c, e)| {
+            if c.is_finite() && e.is_finite() {
+                statistic(opts.score, *c as f64, *e as f64) as f32
+            } else {
+                f32::NAN
+            }
+        })
+        .collect();
+
+    // How far scores stay correlated, then the null from block maxima: the best score in a
+    // stretch of reference unrelated to the trace follows a Gumbel law.
+    let corr_len = score_correlation_length(&cc, trace.len());
+    let nz = cc.iter().filter(|c| c.is_finite()).count();
+    let block_len = ((4.0 * corr_len).ceil() as usize)
+        .max(trace.len() / 2)
+        .max(10);
+    let best_at = (0..cc.len())
+        .filter(|&k| cc[k].is_finite())
+        .max_by(|&a, &b| cc[a].total_cmp(&cc[b]))
+        .unwrap_or(0);
+    let maxima: Vec<f64> = cc
+        .chunks(block_len)
+        .enumerate()
+        // leave out the blocks near the best offset: they may hold the real match
+        .filter(|(i, _)| {
+            let (lo, hi) = (i * block_len, (i + 1) * block_len);
+            hi + trace.len() <= best_at || lo > best_at + trace.len()
+        })
+        .filter_map(|(_, c)| {
+            c.iter()
+                .copied()
+                .filter(|v| v.is_finite())
+                .max_by(f32::total_cmp)
+        })
+        .map(|v| v as f64)
+        .collect();
+    let tail = TailFit::new(maxima.clone());
+
+    // local maxima, best first, with suppression around each pick
+    let mut order: Vec<usize> = (0..cc.len()).filter(|&k| cc[k].is_finite()).collect();
+    order.sort_unstable_by(|&a, &b| cc[b].total_cmp(&cc[a]));
+    let mut picked: Vec<usize> = Vec::new();
+    for k in order {
+        if picked.len() >= opts.top {
+            break;
+        }
+        if picked.iter().any(|&p| p.abs_diff(k) < opts.exclusion) {
+            continue;
+        }
+        picked.push(k);
+    }
+    let candidates = picked
+        .into_iter()
+        .map(|k| {
+            let (c, mae, rmse, overlap) = score_at(&filled, reference, k);
+            // sub-step offset from a parabola through the neighbouring scores
+            let at = |i: Option<usize>| {
+                i.and_then(|i| cc.get(i))
+                    .map(|v| *v as f64)
+                    .filter(|v| v.is_finite())
+            };
+            let frac = match (at(k.checked_sub(1)), at(Some(k + 1))) {
+                (Some(a), Some(b)) => {
+                    let c0 = cc[k] as f64;
+                    let den = a - 2.0 * c0 + b;
+                    if den < 0.0 {
+                        (0.5 * (a - b) / den).clamp(-0.5, 0.5)
+                    } else {
+                        0.0
+                    }
+                }
+                _ => 0.0,
+            };
+            Candidate {
+                offset: k as f64 + frac,
+                cc: c,
+                mae_hz: mae,
+                rmse_hz: rmse,
+                overlap,
+                p_value: tail.p_value(cc[k] as f64),
+            }
+        })
+        .collect();
+    Ok(MatchResult {
+        candidates,
+        offsets: nz,
+        score_corr_len: corr_len,
+        null_blocks: maxima.len(),
+        block_len,
+        tail_u: tail.u,
+        tail_beta: tail.beta,
+        tail_k: tail.k,
+    })
+}
+
+/// CC, MAE, RMSE and overlap at one offset, for checking a claimed time.
+pub fn score_offset(trace: &[f64], reference: &[f64], k: usize) -> Option<(f64, f64, f64, usize)> {
+    if k + trace.len() > reference.len() {
+        return None;
+    }
+    Some(score_at(&fill_gaps(trace), reference, k))
+}
+
+/// An exponential tail fitted to the largest block maxima of the null (peaks over threshold).
+/// The blocks differ (parts of the reference at other frequency levels score far lower), so
+/// only the top of the distribution is modelled.
+struct TailFit {
+    u: f64,
+    beta: f64,
+    k: usize,
+}
+
+impl TailFit {
+    fn new(mut maxima: Vec<f64>) -> Self {
+        maxima.sort_by(|a, b| b.total_cmp(a));
+        let k = (maxima.len() / 4).clamp(3, 20).min(maxima.len());
+        if k < 3 {
+            return TailFit {
+                u: f64::NAN,
+                beta: f64::NAN,
+                k,
+            };
+        }
+        let u = maxima[k - 1];
+        let beta = (maxima[..k - 1].iter().map(|m| m - u).sum::<f64>() / (k - 1) as f64).max(1e-9);
+        TailFit { u, beta, k }
+    }
+
+    /// P(some null block scores ≥ s): 1 − exp(−λ), λ = expected null blocks above s.
+    fn p_value(&self, s: f64) -> f64 {
+        if !(self.u.is_finite() && self.beta.is_finite()) {
+            return 1.0;
+        }
+        let lambda = self.k as f64 * (-(s - self.u).max(0.0) / self.beta).exp();
+        -(-lambda).exp_m1()
+    }
+}
+
+/// Lag (in offsets) at which the autocorrelation of the score sequence falls below 1/e,
+/// measured on up to a million offsets.
+fn score_correlation_length(cc: &[f32], m: usize) -> f64 {
+    let n = cc.len().min(1 << 20);
+    let s: Vec<f64> = cc[..n]
+        .iter()
+        .map(|v| if v.is_finite() { *v as f64 } else { 0.0 })
+        .collect();
+    let mean = s.iter().sum::<f64>() / n as f64;
+    let var = s.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+    if var <= 0.0 || n < 4 {
+        return 1.0;
+    }
+    let max_lag = (2 * m).min(n / 2).max(1);
+    for lag in 1..=max_lag {
+        let c = s[..n - lag]
+            .iter()
+            .zip(&s[lag..])
+            .map(|(a, b)| (a - mean) * (b - mean))
+            .sum::<f64>()
+            / ((n - lag) as f64 * var);
+        if c < (-1.0f64).exp() {
+            return lag as f64;
+        }
+    }
+    max_lag as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grid-like random walk with some fast wiggle, `n` values at 1 s.
+    fn enf(n: usize, seed: u64) -> Vec<f64> {
+        let mut s = seed.wrapping_mul(0x9e3779b97f4a7c15) | 1;
+        let mut g = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (mut x, mut v) = (0.0, 0.0);
+        (0..n)
+            .map(|_| {
+                v = 0.95 * v + 0.0006 * g();
+                x = 0.999 * x + v;
+                50.0 + x + 0.02 * g()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn finds_a_noisy_clip_and_calls_it_significant() {
+        let reference = enf(200_000, 1);
+        let at = 123_457;
+        let noise = enf(600, 9);
+        let clip: Vec<f64> = reference[at..at + 600]
+            .iter()
+            .zip(&noise)
+            .map(|(r, n)| r + 0.1 * (n - 50.0))
+            .collect();
+        let res = match_trace(&clip, &reference, &MatchOptions::default()).unwrap();
+        let best = res.candidates[0];
+        assert_eq!(best.offset.round() as usize, at, "{res:?}");
+        assert!(best.cc > 0.9, "{best:?}");
+        assert!(best.p_value < DEFAULT_ALPHA, "{best:?}");
+        assert!(res.candidates[1].p_value > best.p_value);
+    }
+
+    #[test]
+    fn ffts_agree_with_direct_scores_including_gaps() {
+        let mut reference = enf(70_000, 3);
+        for v in &mut reference[30_000..30_050] {
+            *v = f64::NAN;
+        }
+        let clip = reference[65_536 - 100..65_536 + 200].to_vec(); // straddles a block edge
+        let filled = fill_gaps(&clip);
+        let mean = filled.iter().sum::<f64>() / filled.len() as f64;
+        let q: Vec<f64> = filled.iter().map(|v| v - mean).collect();
+        let r_mean = 50.0;
+        let r: Vec<f64> = reference.iter().map(|v| v - r_mean).collect();
+        let (cc, rmse) = scores_all(&q, mean - r_mean, &r, 240);
+        for k in [0, 1, 29_990, 30_010, 65_000, 65_436, 65_437, 69_700] {
+            let (direct, _, direct_rmse, _) = score_at(&filled, &reference, k);
+            let gaps = reference[k..k + 300].iter().filter(|v| v.is_nan()).count();
+            if 300 - gaps >= 240 {
+                assert!(
+                    (cc[k] as f64 - direct).abs() < 1e-4,
+                    "k {k}: {} vs {direct}",
+                    cc[k]
+                );
+                assert!(
+                    (rmse[k] as f64 - direct_rmse).abs() < 1e-6,
+                    "k {k}: {} vs {direct_rmse}",
+                    rmse[k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_short_flat_clip_is_not_significant() {
+        let reference = enf(100_000, 5);
+        // 20 s of nearly nothing: noise only
+        let clip: Vec<f64> = enf(20, 77)
+            .iter()
+            .map(|v| 50.0 + (v - 50.0) * 0.01)
+            .collect();
+        let res = match_trace(&clip, &reference, &MatchOptions::default()).unwrap();
+        assert!(res.candidates[0].p_value > 0.01, "{:?}", res.candidates[0]);
+    }
+
+    #[test]
+    fn resampling_and_gap_filling() {
+        assert_eq!(
+            resample(&[0.0, 2.0, 4.0], 2.0, 1.0),
+            vec![0.0, 1.0, 2.0, 3.0, 4.0]
+        );
+        let f = fill_gaps(&[f64::NAN, 1.0, f64::NAN, 3.0, f64::NAN]);
+        assert_eq!(f, vec![1.0, 1.0, 2.0, 3.0, 3.0]);
+        // maxima 10, 9, 8, …: k = 3, u = 8, mean excess 1.5; a score at u is beaten by the
+        // 3 blocks at or above it; one far above has a tiny p
+        let t = TailFit::new((0..12).map(|i| 10.0 - i as f64).collect());
+        assert_eq!((t.k, t.u, t.beta), (3, 8.0, 1.5));
+        assert!((t.p_value(8.0) - (1.0 - (-3f64).exp())).abs() < 1e-12);
+        assert!(t.p_value(8.0 + 1.5 * 15.0) < 1e-5);
+    }
+}

@@ -1,0 +1,136 @@
+//! Matching on real ENF: clips of the shared 50 Hz hours and 60 Hz days located in the
+//! references, and clips from a day outside the reference found insignificant.
+//! `#[ignore]`d (needs ../shared); `.ci/run` runs it.
+
+use std::path::PathBuf;
+
+use eenf_cli::pipeline::{reference_file, Nominal};
+use eenf_dsp::matching::{match_trace, MatchOptions, DEFAULT_ALPHA};
+use eenf_dsp::EnfParams;
+
+fn shared() -> PathBuf {
+    let dir = std::env::var_os("EENF_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
+    assert!(
+        dir.join("enf-traces-60hz").is_dir(),
+        "shared data not found at {}",
+        dir.display()
+    );
+    dir
+}
+
+fn day60(name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(shared().join("enf-traces-60hz").join(name)).unwrap();
+    text.lines()
+        .filter_map(|l| l.split(',').nth(1).and_then(|v| v.trim().parse().ok()))
+        .collect()
+}
+
+fn hours50() -> Vec<f64> {
+    let dir = shared().join("enf-reference");
+    let mut wavs: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().map(|e| e == "wav").unwrap_or(false))
+        .collect();
+    wavs.sort();
+    let mut all = Vec::new();
+    for w in wavs {
+        let (_, t) = reference_file(&w, Nominal::Hz(50.0), &EnfParams::default()).unwrap();
+        all.extend_from_slice(&t[..3600]);
+    }
+    all
+}
+
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn unit(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn normal(&mut self) -> f64 {
+        let (a, b) = (self.unit().max(1e-300), self.unit());
+        (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos()
+    }
+}
+
+/// A clip with estimation error: white noise of `noise_hz` smoothed over 3 values.
+fn noisy_clip(src: &[f64], at: usize, len: usize, noise_hz: f64, rng: &mut Rng) -> Vec<f64> {
+    let raw: Vec<f64> = (0..len + 2).map(|_| noise_hz * rng.normal()).collect();
+    (0..len)
+        .map(|i| src[at + i] + (raw[i] + raw[i + 1] + raw[i + 2]) / 3.0_f64.sqrt())
+        .collect()
+}
+
+fn evaluate(
+    name: &str,
+    reference: &[f64],
+    outside: &[f64],
+    len: usize,
+    trials: usize,
+) -> (f64, f64) {
+    let mut rng = Rng(0x1234_5678_9abc_def1 ^ len as u64);
+    let opts = MatchOptions::default();
+    let (mut hits, mut significant_outside, mut significant_hits) = (0, 0, 0);
+    let mut worst_true_p: f64 = 0.0;
+    let mut best_false_p: f64 = 1.0;
+    for _ in 0..trials {
+        let at = (rng.next() % (reference.len() - len) as u64) as usize;
+        let clip = noisy_clip(reference, at, len, 0.0005, &mut rng);
+        let res = match_trace(&clip, reference, &opts).unwrap();
+        let top = res.candidates[0];
+        if (top.offset - at as f64).abs() <= 1.0 {
+            hits += 1;
+            worst_true_p = worst_true_p.max(top.p_value);
+            if top.p_value < DEFAULT_ALPHA {
+                significant_hits += 1;
+            }
+        }
+        let at2 = (rng.next() % (outside.len() - len) as u64) as usize;
+        let clip2 = noisy_clip(outside, at2, len, 0.0005, &mut rng);
+        let res2 = match_trace(&clip2, reference, &opts).unwrap();
+        best_false_p = best_false_p.min(res2.candidates[0].p_value);
+        if res2.candidates[0].p_value < DEFAULT_ALPHA {
+            significant_outside += 1;
+        }
+    }
+    let rate = hits as f64 / trials as f64;
+    let fp = significant_outside as f64 / trials as f64;
+    println!(
+        "{name}: {len}-value clips: top candidate within ±1 step {:.1} % ({hits}/{trials}), significant (p < {DEFAULT_ALPHA}) {:.1} %, worst p of a true match {worst_true_p:.2e}; outside clips significant: {:.1} % (smallest p {best_false_p:.2e})",
+        rate * 100.0,
+        significant_hits as f64 / trials as f64 * 100.0,
+        fp * 100.0
+    );
+    (rate, fp)
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn real_enf_clips_are_placed_and_outsiders_rejected() {
+    // 60 Hz: reference = Aug 1 and 2 (2 s steps), outside = Aug 3
+    let mut r60 = day60("August_01_2022.csv");
+    r60.extend(day60("August_02_2022.csv"));
+    let out60 = day60("August_03_2022.csv");
+    let (hit, fp) = evaluate("60 Hz", &r60, &out60, 150, 200);
+    assert!(
+        hit >= 0.99 && fp <= 0.01,
+        "60 Hz 5 min: hits {hit}, false positives {fp}"
+    );
+    evaluate("60 Hz", &r60, &out60, 30, 200);
+    // 50 Hz: reference = 16:00–19:59, outside = 20:00–21:59 (1 s steps)
+    let h = hours50();
+    let (r50, out50) = h.split_at(4 * 3600);
+    let (hit, fp) = evaluate("50 Hz", r50, out50, 300, 200);
+    assert!(
+        hit >= 0.99 && fp <= 0.01,
+        "50 Hz 5 min: hits {hit}, false positives {fp}"
+    );
+    evaluate("50 Hz", r50, out50, 60, 200);
+}
