@@ -11,4 +11,5 @@ pub mod output;
 pub mod pipeline;
 pub mod plot;
 pub mod progress;
+pub mod refdb;
 pub mod wav;

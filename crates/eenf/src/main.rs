@@ -33,6 +33,11 @@ enum Command {
     Reference(commands::reference::Args),
     /// Compare an ENF trace with a reference: CC, MAE, RMSE, max error.
     Compare(commands::compare::Args),
+    /// Build or inspect a reference store: long ENF series per grid for `match`.
+    #[command(subcommand)]
+    Refdb(commands::refdb::Cmd),
+    /// Find when a trace was recorded by matching it against long references.
+    Match(commands::matching::Args),
     /// Simulate an event recording of a flickering scene, with its ground-truth ENF.
     Simulate(commands::simulate::Args),
     /// Simulate 60 s, extract the ENF, compare it with the truth: the whole method in one go.
@@ -48,6 +53,8 @@ fn main() -> ExitCode {
         Command::Extract(a) => commands::extract::run(a, progress),
         Command::Reference(a) => commands::reference::run(a, progress),
         Command::Compare(a) => commands::compare::run(a, progress),
+        Command::Refdb(c) => commands::refdb::run(c, progress),
+        Command::Match(a) => commands::matching::run(a, progress),
         Command::Simulate(a) => commands::simulate::run(a, progress).map(|_| ()),
         Command::Demo(a) => commands::demo::run(a, progress),
     };

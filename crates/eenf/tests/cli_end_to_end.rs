@@ -159,3 +159,101 @@ fn hourly_references_align_by_name_across_the_hour() {
     ));
     assert!(off["mae_hz"].as_f64().unwrap() > 2.0 * mae, "{off}");
 }
+
+#[test]
+fn refdb_and_match_locate_a_clip() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let mains = MainsPhase::synthetic(50.0, 7200.0, SyntheticEnf::default(), 8);
+    let fs = 200.0;
+    let volts: Vec<f64> = (0..(7200.0 * fs) as usize)
+        .map(|i| 0.6 * mains.phase_at(i as f64 / fs).cos())
+        .collect();
+    let hour = (3600.0 * fs) as usize;
+    eenf_cli::wav::write_wav(&d.join("2022_08_17_Wed_16_00_00.wav"), 200, &volts[..hour]).unwrap();
+    eenf_cli::wav::write_wav(&d.join("2022_08_17_Wed_17_00_00.wav"), 200, &volts[hour..]).unwrap();
+    eenf(
+        &[
+            "-q",
+            "refdb",
+            "build",
+            "store",
+            "2022_08_17_Wed_16_00_00.wav",
+            "2022_08_17_Wed_17_00_00.wav",
+            "--tz",
+            "+08:00",
+        ],
+        d,
+    );
+    let info = eenf(&["refdb", "info", "store"], d);
+    assert!(info.contains("from        2022-08-17T08:00:00Z"), "{info}");
+    assert!(info.contains("100.0 % covered"), "{info}");
+    // a 5-minute clip of the 17:xx reference with a little estimation noise
+    eenf(
+        &[
+            "-q",
+            "reference",
+            "2022_08_17_Wed_17_00_00.wav",
+            "-o",
+            "r17.csv",
+        ],
+        d,
+    );
+    let text = std::fs::read_to_string(d.join("r17.csv")).unwrap();
+    let vals: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    let at = 1234;
+    let mut clip = String::from("time_s,enf_hz\n");
+    for (i, v) in vals[at..at + 300].iter().enumerate() {
+        clip.push_str(&format!(
+            "{i},{}\n",
+            v + 0.0002 * ((i * 7919 % 13) as f64 - 6.0) / 6.0
+        ));
+    }
+    std::fs::write(d.join("clip.csv"), clip).unwrap();
+    let m = json(&eenf(
+        &[
+            "match",
+            "clip.csv",
+            "store",
+            "--json",
+            "--verify",
+            "2022-08-17T17:20:34+08:00",
+        ],
+        d,
+    ));
+    let top = &m["candidates"][0];
+    // 17:00 + 1234 s local (+08:00) = 2022-08-17T09:20:34Z
+    let want = 1_660_728_034.0;
+    assert!((top["start_s"].as_f64().unwrap() - want).abs() < 0.5, "{m}");
+    assert_eq!(top["match"], true, "{m}");
+    assert_eq!(m["verify"]["rank"], 1, "{m}");
+    // a wrong claim ranks far down
+    let w = json(&eenf(
+        &[
+            "match",
+            "clip.csv",
+            "store",
+            "--json",
+            "--verify",
+            "2022-08-17T16:30:00+08:00",
+        ],
+        d,
+    ));
+    assert!(w["verify"]["rank"].as_u64().unwrap() > 1, "{w}");
+    // 60 Hz traces never match a 50 Hz grid
+    let sixty: String = std::iter::once("time_s,enf_hz\n".to_string())
+        .chain((0..300).map(|i| format!("{i},{}\n", 60.0 + 0.01 * (i as f64 / 30.0).sin())))
+        .collect();
+    std::fs::write(d.join("sixty.csv"), sixty).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_eenf"))
+        .args(["match", "sixty.csv", "store"])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no 60 Hz grid"));
+}

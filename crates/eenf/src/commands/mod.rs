@@ -5,6 +5,8 @@ pub mod convert;
 pub mod demo;
 pub mod extract;
 pub mod info;
+pub mod matching;
 pub mod method;
+pub mod refdb;
 pub mod reference;
 pub mod simulate;

@@ -1,0 +1,230 @@
+//! `eenf refdb build|info`: the reference store.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use eenf_cli::dataset::reference_hour;
+use eenf_cli::output::read_trace;
+use eenf_cli::pipeline::{days_from_civil, reference_file, Nominal};
+use eenf_cli::progress::Progress;
+use eenf_cli::refdb::{parse_time, tz_offset, utc, RefSeries, GAP};
+use eenf_dsp::EnfParams;
+
+/// `eenf refdb` subcommands.
+#[derive(Debug, clap::Subcommand)]
+pub enum Cmd {
+    /// Add mains WAVs (named like 2022_08_17_Wed_16_00_00.wav) or trace CSVs to a store
+    /// (created when missing). One series per grid; new values replace old, gaps stay gaps.
+    Build(BuildArgs),
+    /// Show what a store covers.
+    Info {
+        /// The store (a folder).
+        store: PathBuf,
+    },
+}
+
+/// Arguments of `eenf refdb build`.
+#[derive(Debug, clap::Args)]
+pub struct BuildArgs {
+    /// The store (a folder).
+    pub store: PathBuf,
+    /// Inputs: hourly mains WAVs, or trace CSVs (`time_s,enf_hz`, or `index,freq_hz` with
+    /// --step). A CSV may carry its start as `FILE@2022-08-01T00:00:00Z`; otherwise the first
+    /// takes --start and each next one continues where the previous ended.
+    #[arg(required = true)]
+    pub inputs: Vec<String>,
+    /// Grid name (default: `grid50` or `grid60` from the data).
+    #[arg(long)]
+    pub grid: Option<String>,
+    /// UTC offset of the local times in WAV names, e.g. +08:00.
+    #[arg(long, default_value = "+00:00", allow_hyphen_values = true)]
+    pub tz: String,
+    /// Start time of the first trace CSV (UTC, or with an offset).
+    #[arg(long)]
+    pub start: Option<String>,
+    /// Seconds between values of `index` CSVs.
+    #[arg(long)]
+    pub step: Option<f64>,
+}
+
+fn nominal_of(values: &[f64], what: &str) -> Result<f64> {
+    let v: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    if v.is_empty() {
+        bail!("{what}: no values");
+    }
+    let mean = v.iter().sum::<f64>() / v.len() as f64;
+    [50.0, 60.0]
+        .into_iter()
+        .find(|f| (mean - f).abs() < 1.0)
+        .with_context(|| format!("{what}: mean {mean:.3} Hz is neither a 50 nor a 60 Hz grid"))
+}
+
+/// A two-column CSV: `time_s,enf_hz` (eenf traces) or `index,value` (needs `step`).
+fn read_csv(path: &Path, step: Option<f64>) -> Result<(f64, Vec<f64>)> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+    let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
+    if header.contains("time_s") {
+        let t = read_trace(path)?;
+        let step = if t.time_s.len() > 1 {
+            t.time_s[1] - t.time_s[0]
+        } else {
+            1.0
+        };
+        return Ok((step, t.enf_hz));
+    }
+    let step = step.with_context(|| format!("{}: an index CSV needs --step", path.display()))?;
+    // a header row is one whose first field is not a number
+    let skip = usize::from(
+        text.lines()
+            .next()
+            .and_then(|l| l.split(',').next())
+            .map(|f| f.trim().parse::<f64>().is_err())
+            .unwrap_or(false),
+    );
+    let mut vals = Vec::new();
+    for (i, line) in text.lines().skip(skip).enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let v = line
+            .split(',')
+            .nth(1)
+            .and_then(|v| v.trim().parse::<f64>().ok())
+            .with_context(|| {
+                format!(
+                    "{}: line {}: expected index,value",
+                    path.display(),
+                    i + 1 + skip
+                )
+            })?;
+        vals.push(v);
+    }
+    Ok((step, vals))
+}
+
+fn is_wav(path: &Path) -> bool {
+    use std::io::Read;
+    let mut h = [0u8; 12];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut h))
+        .map(|_| &h[..4] == b"RIFF" && &h[8..] == b"WAVE")
+        .unwrap_or(false)
+}
+
+/// Unix time of an hourly reference's name in local time at `tz`.
+pub fn wav_start(path: &Path, tz: f64) -> Result<f64> {
+    let t = reference_hour(path).with_context(|| {
+        format!(
+            "{}: the name gives no start time (expected 2022_08_17_Wed_16_00_00.wav)",
+            path.display()
+        )
+    })?;
+    let days = days_from_civil(t.year as i64, t.month, t.day);
+    Ok(days as f64 * 86_400.0 + (t.hour * 3600 + t.minute * 60 + t.second) as f64 - tz)
+}
+
+fn build(a: BuildArgs, progress: Progress) -> Result<()> {
+    let tz = tz_offset(&a.tz)?;
+    let bar = progress.steps(a.inputs.len() as u64, "adding references");
+    let mut series: Vec<RefSeries> = Vec::new();
+    let mut next_start = a.start.as_deref().map(parse_time).transpose()?;
+    for input in &a.inputs {
+        let (path, at) = match input.rsplit_once('@') {
+            Some((p, t)) if !Path::new(input).exists() => (PathBuf::from(p), Some(parse_time(t)?)),
+            _ => (PathBuf::from(input), None),
+        };
+        let (start, step, values) = if is_wav(&path) {
+            let (_, trace) = reference_file(&path, Nominal::Auto, &EnfParams::default())?;
+            (at.unwrap_or(wav_start(&path, tz)?), 1.0, trace)
+        } else {
+            let (step, values) = read_csv(&path, a.step)?;
+            let start = at.or(next_start).with_context(|| {
+                format!(
+                    "{}: give its start as FILE@TIME or with --start",
+                    path.display()
+                )
+            })?;
+            (start, step, values)
+        };
+        next_start = Some(start + values.len() as f64 * step);
+        let f0 = nominal_of(&values, &path.display().to_string())?;
+        let grid = a
+            .grid
+            .clone()
+            .unwrap_or_else(|| format!("grid{}", f0 as u32));
+        let idx = match series.iter().position(|s| s.meta.grid == grid) {
+            Some(i) => i,
+            None => {
+                let s = if a.store.join(format!("{grid}.json")).exists() {
+                    RefSeries::load(&a.store, &grid)?
+                } else {
+                    RefSeries::new(&grid, f0, step, start)
+                };
+                series.push(s);
+                series.len() - 1
+            }
+        };
+        let s = &mut series[idx];
+        if s.meta.nominal_hz != f0 {
+            bail!(
+                "{}: a {f0} Hz trace cannot go into grid {grid:?}, which is {} Hz (50 and 60 Hz are never mixed)",
+                path.display(),
+                s.meta.nominal_hz
+            );
+        }
+        s.merge(start, step, &values)?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    for s in &mut series {
+        s.save(&a.store)?;
+        eprintln!(
+            "{}: grid {} now holds {} values",
+            a.store.display(),
+            s.meta.grid,
+            s.values.len()
+        );
+    }
+    info(&a.store)
+}
+
+fn info(store: &Path) -> Result<()> {
+    let grids = RefSeries::grids(store)?;
+    if grids.is_empty() {
+        bail!("{}: no reference series here", store.display());
+    }
+    for g in grids {
+        let s = RefSeries::load(store, &g)?;
+        let m = &s.meta;
+        let gaps = s.values.iter().filter(|&&v| v == GAP).count();
+        let runs = s
+            .values
+            .windows(2)
+            .filter(|w| w[0] != GAP && w[1] == GAP)
+            .count()
+            + usize::from(s.values.first() == Some(&GAP));
+        let end = m.start_unix_s + (s.values.len().max(1) - 1) as f64 * m.step_s;
+        println!("grid        {}", m.grid);
+        println!("nominal     {} Hz", m.nominal_hz);
+        println!("step        {} s", m.step_s);
+        println!("from        {}", utc(m.start_unix_s));
+        println!("to          {}", utc(end));
+        println!(
+            "values      {} ({:.1} % covered, {} gaps in {} runs)",
+            s.values.len(),
+            100.0 * (s.values.len() - gaps) as f64 / s.values.len().max(1) as f64,
+            gaps,
+            runs
+        );
+        println!("size        {:.1} MB", s.values.len() as f64 * 4.0 / 1e6);
+        println!();
+    }
+    Ok(())
+}
+
+pub fn run(cmd: Cmd, progress: Progress) -> Result<()> {
+    match cmd {
+        Cmd::Build(a) => build(a, progress),
+        Cmd::Info { store } => info(&store),
+    }
+}
