@@ -128,6 +128,55 @@ pub enum MatchError {
     Flat,
 }
 
+/// Values of a reference series, read where needed (a year of them need not be copied).
+pub trait ReferenceValues: Sync {
+    /// Number of values.
+    fn len(&self) -> usize;
+    /// Value `i` in Hz, NaN for a gap.
+    fn get(&self, i: usize) -> f64;
+    /// True when there is no value.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl ReferenceValues for [f64] {
+    fn len(&self) -> usize {
+        <[f64]>::len(self)
+    }
+    #[inline]
+    fn get(&self, i: usize) -> f64 {
+        self[i]
+    }
+}
+
+/// A series stored as integers: `offset_hz + value · scale_hz`, with `gap` marking none.
+pub struct ScaledSeries<'a> {
+    /// Stored values.
+    pub values: &'a [i32],
+    /// Value of 0, Hz.
+    pub offset_hz: f64,
+    /// Hz per unit.
+    pub scale_hz: f64,
+    /// The value that marks a gap.
+    pub gap: i32,
+}
+
+impl ReferenceValues for ScaledSeries<'_> {
+    fn len(&self) -> usize {
+        self.values.len()
+    }
+    #[inline]
+    fn get(&self, i: usize) -> f64 {
+        let v = self.values[i];
+        if v == self.gap {
+            f64::NAN
+        } else {
+            self.offset_hz + v as f64 * self.scale_hz
+        }
+    }
+}
+
 /// Fills NaN gaps of a trace by linear interpolation (ends by the nearest value).
 pub fn fill_gaps(x: &[f64]) -> Vec<f64> {
     let mut out = x.to_vec();
@@ -168,10 +217,11 @@ pub fn resample(x: &[f64], from_step: f64, to_step: f64) -> Vec<f64> {
 }
 
 /// Pearson CC, MAE and RMSE of `q` against `r[k..k + q.len()]` over the values valid in both.
-fn score_at(q: &[f64], r: &[f64], k: usize) -> (f64, f64, f64, usize) {
+fn score_at<R: ReferenceValues + ?Sized>(q: &[f64], r: &R, k: usize) -> (f64, f64, f64, usize) {
     let (mut n, mut sq, mut sr, mut sqq, mut srr, mut sqr, mut abs, mut sq_err) =
         (0usize, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    for (a, b) in q.iter().zip(&r[k..k + q.len()]) {
+    for (i, a) in q.iter().enumerate() {
+        let b = &r.get(k + i);
         if a.is_finite() && b.is_finite() {
             n += 1;
             sq += a;
@@ -229,10 +279,10 @@ fn statistic(score: Score, cc: f64, rmse: f64) -> f64 {
 /// every window of `reference` (NaN = gap; `r_mean` is subtracted on the fly to keep the running
 /// sums well conditioned), by overlap-save FFT blocks and running sums; windows with gaps are
 /// scored directly.
-fn scores_all(
+fn scores_all<R: ReferenceValues + ?Sized>(
     q: &[f64],
     q_mean: f64,
-    reference: &[f64],
+    reference: &R,
     r_mean: f64,
     min_valid: usize,
     score: Score,
@@ -268,13 +318,18 @@ fn scores_all(
         |(buf, spec, s1, s2), (bi, dst)| {
             let start = bi * hop;
             let end = (start + block).min(r.len());
-            let seg = &r[start..end];
+            let seg_len = end - start;
+            let at = |i: usize| {
+                if i < seg_len {
+                    r.get(start + i)
+                } else {
+                    f64::NAN
+                }
+            };
             // gaps count as zero in the FFT; their windows are redone below
-            for (d, s) in buf
-                .iter_mut()
-                .zip(seg.iter().chain(std::iter::repeat(&f64::NAN)))
-            {
-                *d = if s.is_finite() { *s - r_mean } else { 0.0 };
+            for (j, d) in buf.iter_mut().enumerate() {
+                let s = at(j);
+                *d = if s.is_finite() { s - r_mean } else { 0.0 };
             }
             fwd.process_with_scratch(buf, spec, s1)
                 .expect("sized by plan");
@@ -285,7 +340,7 @@ fn scores_all(
                 .expect("sized by plan");
             // running window sums of r, r² and the gap count
             let (mut s, mut ss, mut gaps) = (0.0f64, 0.0f64, 0usize);
-            let value = |i: usize| seg.get(i).map_or(f64::NAN, |v| v - r_mean);
+            let value = |i: usize| at(i) - r_mean;
             for v in (0..m).map(value) {
                 if v.is_finite() {
                     s += v;
@@ -339,9 +394,9 @@ fn scores_all(
 
 /// Finds where `trace` (step-aligned with `reference`, NaN = missing) best fits in
 /// `reference` (NaN = gap).
-pub fn match_trace(
+pub fn match_trace<R: ReferenceValues + ?Sized>(
     trace: &[f64],
-    reference: &[f64],
+    reference: &R,
     opts: &MatchOptions,
 ) -> Result<MatchResult, MatchError> {
     let usable = trace.iter().filter(|v| v.is_finite()).count();
@@ -363,8 +418,9 @@ pub fn match_trace(
     let min_valid = ((opts.min_overlap * trace.len() as f64).ceil() as usize).max(3);
     // deviations from the reference's own mean keep the running sums well conditioned
     let r_mean = {
-        let (s, n) = reference
-            .par_iter()
+        let (s, n) = (0..reference.len())
+            .into_par_iter()
+            .map(|i| reference.get(i))
             .filter(|v| v.is_finite())
             .fold(|| (0.0, 0usize), |(s, n), v| (s + v, n + 1))
             .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
@@ -516,7 +572,11 @@ pub fn match_trace(
 }
 
 /// CC, MAE, RMSE and overlap at one offset, for checking a claimed time.
-pub fn score_offset(trace: &[f64], reference: &[f64], k: usize) -> Option<(f64, f64, f64, usize)> {
+pub fn score_offset<R: ReferenceValues + ?Sized>(
+    trace: &[f64],
+    reference: &R,
+    k: usize,
+) -> Option<(f64, f64, f64, usize)> {
     if k + trace.len() > reference.len() {
         return None;
     }
@@ -619,7 +679,7 @@ mod tests {
             .zip(&noise)
             .map(|(r, n)| r + 0.1 * (n - 50.0))
             .collect();
-        let res = match_trace(&clip, &reference, &MatchOptions::default()).unwrap();
+        let res = match_trace(&clip, &reference[..], &MatchOptions::default()).unwrap();
         let best = res.candidates[0];
         assert_eq!(best.offset.round() as usize, at, "{res:?}");
         assert!(best.cc > 0.9, "{best:?}");
@@ -638,10 +698,17 @@ mod tests {
         let mean = filled.iter().sum::<f64>() / filled.len() as f64;
         let q: Vec<f64> = filled.iter().map(|v| v - mean).collect();
         let r_mean = 50.0;
-        let cc = scores_all(&q, mean - r_mean, &reference, r_mean, 240, Score::Cc);
-        let comb = scores_all(&q, mean - r_mean, &reference, r_mean, 240, Score::Combined);
+        let cc = scores_all(&q, mean - r_mean, &reference[..], r_mean, 240, Score::Cc);
+        let comb = scores_all(
+            &q,
+            mean - r_mean,
+            &reference[..],
+            r_mean,
+            240,
+            Score::Combined,
+        );
         for k in [0, 1, 29_990, 30_010, 65_000, 65_436, 65_437, 69_700] {
-            let (direct, _, direct_rmse, _) = score_at(&filled, &reference, k);
+            let (direct, _, direct_rmse, _) = score_at(&filled, &reference[..], k);
             let gaps = reference[k..k + 300].iter().filter(|v| v.is_nan()).count();
             if 300 - gaps >= 240 {
                 let want = statistic(Score::Cc, direct, direct_rmse);
@@ -665,7 +732,7 @@ mod tests {
             .iter()
             .map(|v| 50.0 + (v - 50.0) * 0.01)
             .collect();
-        let res = match_trace(&clip, &reference, &MatchOptions::default()).unwrap();
+        let res = match_trace(&clip, &reference[..], &MatchOptions::default()).unwrap();
         assert!(res.candidates[0].p_value > 0.01, "{:?}", res.candidates[0]);
     }
 

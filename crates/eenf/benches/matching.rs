@@ -21,7 +21,7 @@ fn benches(c: &mut Criterion) {
     });
     g.bench_function("1year_1s", |b| {
         b.iter(|| {
-            let r = match_trace(&clip, &year, &MatchOptions::default()).unwrap();
+            let r = match_trace(&clip, &year[..], &MatchOptions::default()).unwrap();
             assert_eq!(r.candidates[0].offset.round() as usize, at);
         })
     });

@@ -8,8 +8,10 @@ use eenf_cli::output::read_trace;
 use eenf_cli::pipeline::{reference_file, Nominal};
 use eenf_cli::plot::plot_comparison;
 use eenf_cli::progress::Progress;
-use eenf_cli::refdb::{parse_time, tz_offset, utc, RefSeries};
-use eenf_dsp::matching::{match_trace, resample, MatchOptions, Score, DEFAULT_ALPHA};
+use eenf_cli::refdb::{parse_time, tz_offset, utc, RefSeries, GAP};
+use eenf_dsp::matching::{
+    match_trace, resample, MatchOptions, ReferenceValues, ScaledSeries, Score, DEFAULT_ALPHA,
+};
 use eenf_dsp::EnfParams;
 
 use super::refdb::wav_start;
@@ -61,7 +63,51 @@ struct Reference {
     start: f64,
     absolute: bool,
     step: f64,
-    hz: Vec<f64>,
+    data: RefData,
+}
+
+/// Reference values: in Hz, or as stored (µHz from nominal), read in place.
+enum RefData {
+    Hz(Vec<f64>),
+    Stored { values: Vec<i32>, nominal: f64 },
+}
+
+impl RefData {
+    fn scaled(values: &[i32], nominal: f64) -> ScaledSeries<'_> {
+        ScaledSeries {
+            values,
+            offset_hz: nominal,
+            scale_hz: 1e-6,
+            gap: GAP,
+        }
+    }
+
+    fn len(&self) -> usize {
+        match self {
+            RefData::Hz(v) => v.len(),
+            RefData::Stored { values, .. } => values.len(),
+        }
+    }
+
+    fn get(&self, i: usize) -> f64 {
+        match self {
+            RefData::Hz(v) => v[i],
+            RefData::Stored { values, nominal } => Self::scaled(values, *nominal).get(i),
+        }
+    }
+
+    fn search(
+        &self,
+        q: &[f64],
+        opts: &MatchOptions,
+    ) -> Result<eenf_dsp::matching::MatchResult, eenf_dsp::matching::MatchError> {
+        match self {
+            RefData::Hz(v) => match_trace(q, &v[..], opts),
+            RefData::Stored { values, nominal } => {
+                match_trace(q, &Self::scaled(values, *nominal), opts)
+            }
+        }
+    }
 }
 
 fn load_references(
@@ -85,7 +131,10 @@ fn load_references(
                     start: meta.start_unix_s,
                     absolute: true,
                     step: meta.step_s,
-                    hz: s.hz(),
+                    data: RefData::Stored {
+                        values: s.values,
+                        nominal,
+                    },
                 });
             }
             if out.is_empty() {
@@ -113,7 +162,7 @@ fn load_references(
             start: series.meta.start_unix_s,
             absolute: true,
             step: 1.0,
-            hz: series.hz(),
+            data: RefData::Hz(series.hz()),
         }]);
     }
     let mut head = [0u8; 4];
@@ -146,7 +195,7 @@ fn load_references(
         start,
         absolute,
         step,
-        hz,
+        data: RefData::Hz(hz),
     }])
 }
 
@@ -204,7 +253,9 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             verify,
             ..MatchOptions::default()
         };
-        let res = match_trace(&q, &r.hz, &opts)
+        let res = r
+            .data
+            .search(&q, &opts)
             .map_err(|e| anyhow::anyhow!("{}: {e}", a.trace.display()))?;
         if let Some(v) = res.verification {
             verification = Some((r, v));
@@ -230,7 +281,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     };
     if let (Some(p), Some((r, c))) = (&a.plot, rows.first()) {
         let k = c.offset.round() as usize;
-        let n = trace.enf_hz.len().min(r.hz.len().saturating_sub(k));
+        let n = trace.enf_hz.len().min(r.data.len().saturating_sub(k));
         let q = resample(&trace.enf_hz, step, r.step);
         let n = n.min(q.len());
         let t: Vec<f64> = (0..n).map(|i| i as f64 * r.step).collect();
@@ -245,7 +296,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             ),
             &t,
             &q[..n],
-            &r.hz[k..k + n],
+            &(k..k + n).map(|i| r.data.get(i)).collect::<Vec<_>>(),
         )?;
     }
     if a.json {
