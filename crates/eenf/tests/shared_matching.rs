@@ -134,3 +134,34 @@ fn real_enf_clips_are_placed_and_outsiders_rejected() {
     );
     evaluate("50 Hz", r50, out50, 60, 200);
 }
+
+#[test]
+#[ignore = "needs ../shared"]
+fn an_eenf_trace_from_a_simulated_recording_is_placed_at_its_time() {
+    use eenf_cli::pipeline::{extract_file, ExtractOptions};
+    use eenf_cli::progress::Progress;
+    use eenf_events::{Aedat4Writer, Compression};
+    use eenf_sim::{simulate, MainsPhase, SimConfig};
+
+    let wav = shared().join("enf-reference/2022_08_17_Wed_17_00_00.wav");
+    let sig = eenf_cli::wav::read_wav(&wav).unwrap();
+    let config = SimConfig {
+        duration_s: 300.0,
+        seed: 17,
+        ..SimConfig::default()
+    };
+    let mains = MainsPhase::from_recording(&sig.samples, sig.fs, 50.0, 1200.0, 300.0).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let rec = tmp.path().join("clip.aedat4");
+    let mut w = Aedat4Writer::create(&rec, Compression::Lz4, config.width, config.height).unwrap();
+    simulate(&config, &mains, |b| w.write(b)).unwrap();
+    w.finish().unwrap();
+    let x = extract_file(&rec, &ExtractOptions::default(), &Progress::hidden()).unwrap();
+    // the six hours from 16:00; the recording starts at 17:20:00, value 3600 + 1200
+    let hours = hours50();
+    let res = match_trace(&x.trace.enf_hz, &hours[..], &MatchOptions::default()).unwrap();
+    let top = res.candidates[0];
+    println!("E-ENF clip: {top:?}");
+    assert!((top.offset - 4800.0).abs() <= 1.0, "{top:?}");
+    assert!(top.p_value < DEFAULT_ALPHA, "{top:?}");
+}
