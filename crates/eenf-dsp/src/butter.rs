@@ -115,37 +115,9 @@ fn zpk2sos_nearest(zeros: &mut Vec<f64>, poles: Vec<C>, k: f64) -> Vec<Section> 
     let n_sections = half.len();
     let mut sos = vec![[0.0; 6]; n_sections];
     for si in (0..n_sections).rev() {
-        let (idx, _) = half
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (i, (1.0 - p.abs()).abs()))
-            .fold(
-                (0, f64::INFINITY),
-                |best, cur| {
-                    if cur.1 < best.1 {
-                        cur
-                    } else {
-                        best
-                    }
-                },
-            );
-        let p1 = half.remove(idx);
-        let take_nearest = |zs: &mut Vec<f64>| -> f64 {
-            let (i, _) = zs
-                .iter()
-                .enumerate()
-                .map(|(i, z)| (i, C::new(*z, 0.0).sub(p1).abs()))
-                .fold(
-                    (0, f64::INFINITY),
-                    |best, cur| {
-                        if cur.1 < best.1 {
-                            cur
-                        } else {
-                            best
-                        }
-                    },
-                );
-            zs.remove(i)
+        let p1 = half.remove(first_min(half.iter().map(|p| (1.0 - p.abs()).abs())));
+        let take_nearest = |zs: &mut Vec<f64>| {
+            zs.remove(first_min(zs.iter().map(|z| C::new(*z, 0.0).sub(p1).abs())))
         };
         let z1 = take_nearest(zeros);
         let z2 = take_nearest(zeros);
@@ -162,6 +134,17 @@ fn zpk2sos_nearest(zeros: &mut Vec<f64>, poles: Vec<C>, k: f64) -> Vec<Section> 
         *c *= k;
     }
     sos
+}
+
+/// Index of the first smallest value (numpy's argmin, which scipy's pairing relies on).
+fn first_min(values: impl Iterator<Item = f64>) -> usize {
+    values
+        .enumerate()
+        .fold(
+            (0, f64::INFINITY),
+            |best, (i, v)| if v < best.1 { (i, v) } else { best },
+        )
+        .0
 }
 
 /// Multiplies sections into one transfer function `(b, a)`, for comparison with `filtfilt`.

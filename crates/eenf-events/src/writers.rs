@@ -126,7 +126,7 @@ impl AtomicFile {
             .into_inner()
             .map_err(|e| io_err(&self.tmp, e.into_error()))?;
         f.sync_all().map_err(|e| io_err(&self.tmp, e))?;
-        std::fs::rename(&self.tmp, &self.path).map_err(|e| io_err(&self.path, e))
+        crate::commit_tmp(&self.tmp, &self.path).map_err(|e| io_err(&self.path, e))
     }
 }
 

@@ -17,7 +17,7 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()
         Ok(())
     })();
     match res {
-        Ok(()) => std::fs::rename(&tmp, path).with_context(|| {
+        Ok(()) => eenf_events::commit_tmp(&tmp, path).with_context(|| {
             format!(
                 "{}: cannot move the finished file into place",
                 path.display()

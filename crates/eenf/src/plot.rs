@@ -5,6 +5,7 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Context, Result};
 use eenf_dsp::EnfTrace;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -34,7 +35,13 @@ fn render(
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("plot");
-    let tmp = path.with_file_name(format!(".{stem}.{}.tmp.{ext}", std::process::id()));
+    // the backend picks the image format from the extension, so the temporary name keeps it
+    let tmp_name = format!(".{stem}.{}.tmp.{ext}", std::process::id());
+    let tmp = if eenf_events::is_special_file(path) {
+        std::env::temp_dir().join(tmp_name)
+    } else {
+        path.with_file_name(tmp_name)
+    };
     let res = match ext.as_str() {
         "png" => {
             let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
@@ -47,7 +54,9 @@ fn render(
         _ => bail!("{}: plots are written as .png or .svg", path.display()),
     };
     match res {
-        Ok(()) => std::fs::rename(&tmp, path).with_context(|| format!("{}", path.display())),
+        Ok(()) => {
+            eenf_events::commit_tmp(&tmp, path).with_context(|| format!("{}", path.display()))
+        }
         Err(err) => {
             let _ = std::fs::remove_file(&tmp);
             Err(err.context(format!("{}: cannot draw the plot", path.display())))
@@ -68,6 +77,37 @@ fn range(vals: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+type Panel<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The upper panel of both figures: ENF in Hz over time.
+fn enf_panel<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> Result<Panel<'a, DB>> {
+    let mut c = ChartBuilder::on(area)
+        .margin(12)
+        .x_label_area_size(30)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x.0..x.1, y.0..y.1)
+        .map_err(e)?;
+    c.configure_mesh()
+        .y_desc("ENF (Hz)")
+        .y_label_formatter(&|v| format!("{v:.3}"))
+        .draw()
+        .map_err(e)?;
+    Ok(c)
+}
+
+fn legend<'a, DB: DrawingBackend + 'a>(c: &mut Panel<'a, DB>) -> Result<()> {
+    c.configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(e)
+}
+
 fn comparison<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
@@ -80,17 +120,7 @@ fn comparison<DB: DrawingBackend>(
     let (upper, lower) = root.split_vertically(SIZE.1 as i32 * 62 / 100);
     let x = range(t.iter().copied());
     let y = range(est.iter().chain(reference).copied());
-    let mut c = ChartBuilder::on(&upper)
-        .margin(12)
-        .x_label_area_size(30)
-        .y_label_area_size(80)
-        .build_cartesian_2d(x.0..x.1, y.0..y.1)
-        .map_err(e)?;
-    c.configure_mesh()
-        .y_desc("ENF (Hz)")
-        .y_label_formatter(&|v| format!("{v:.3}"))
-        .draw()
-        .map_err(e)?;
+    let mut c = enf_panel(&upper, x, y)?;
     c.draw_series(LineSeries::new(
         t.iter().zip(reference).map(|(a, b)| (*a, *b)),
         BLACK.stroke_width(2),
@@ -105,12 +135,7 @@ fn comparison<DB: DrawingBackend>(
     .map_err(e)?
     .label("estimate")
     .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
-    c.configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(e)?;
+    legend(&mut c)?;
     let err: Vec<f64> = est
         .iter()
         .zip(reference)
@@ -166,17 +191,7 @@ fn extraction<DB: DrawingBackend>(
     let t: Vec<f64> = (0..n).map(|i| i as f64 * tr.step_s).collect();
     let x = (0.0, (n.max(2) - 1) as f64 * tr.step_s);
     let y = range(tr.harmonics.iter().flat_map(|h| h.enf_hz.iter().copied()));
-    let mut c = ChartBuilder::on(&upper)
-        .margin(12)
-        .x_label_area_size(30)
-        .y_label_area_size(80)
-        .build_cartesian_2d(x.0..x.1, y.0..y.1)
-        .map_err(e)?;
-    c.configure_mesh()
-        .y_desc("ENF (Hz)")
-        .y_label_formatter(&|v| format!("{v:.3}"))
-        .draw()
-        .map_err(e)?;
+    let mut c = enf_panel(&upper, x, y)?;
     for (k, h) in tr.harmonics.iter().enumerate() {
         let col = PALETTE[k % PALETTE.len()];
         c.draw_series(LineSeries::new(
@@ -200,12 +215,7 @@ fn extraction<DB: DrawingBackend>(
     .map_err(e)?
     .label("selected (ENF)")
     .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(3)));
-    c.configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(e)?;
+    legend(&mut c)?;
     let mmax = tr.harmonics.iter().map(|h| h.harmonic).max().unwrap_or(1) as f64;
     let mut c = ChartBuilder::on(&lower)
         .margin(12)

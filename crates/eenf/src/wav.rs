@@ -84,7 +84,9 @@ pub fn write_wav(path: &Path, fs: u32, samples: &[f64]) -> Result<()> {
         Ok(())
     })();
     match res {
-        Ok(()) => std::fs::rename(&tmp, path).with_context(|| format!("{}", path.display())),
+        Ok(()) => {
+            eenf_events::commit_tmp(&tmp, path).with_context(|| format!("{}", path.display()))
+        }
         Err(e) => {
             let _ = std::fs::remove_file(&tmp);
             Err(e.context(format!("{}: cannot write WAV", path.display())))

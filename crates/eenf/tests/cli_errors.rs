@@ -178,3 +178,45 @@ fn outputs_are_all_or_nothing() {
         "{names:?}"
     );
 }
+
+#[cfg(unix)]
+#[test]
+fn writing_to_a_fifo_writes_into_it_instead_of_replacing_it() {
+    // a FIFO stands in for devices like /dev/null: it must be written into, not renamed over
+    use std::os::unix::fs::FileTypeExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    simulate(d, "s.aedat4", "20");
+    let fifo = d.join("out.fifo");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    if !made.map(|s| s.success()).unwrap_or(false) {
+        panic!("mkfifo is needed for this test");
+    }
+    for (args, starts) in [
+        (
+            vec!["-q", "convert", "s.aedat4", "out.fifo", "--format", "evt3"],
+            &b"% evt 3.0"[..],
+        ),
+        (
+            vec![
+                "-q", "convert", "s.aedat4", "out.fifo", "--format", "aedat4",
+            ],
+            &b"#!AER-DAT4.0"[..],
+        ),
+        (
+            vec!["-q", "extract", "s.aedat4", "-o", "out.fifo"],
+            &b"time_s,enf_hz"[..],
+        ),
+    ] {
+        let path = fifo.clone();
+        let reader = std::thread::spawn(move || std::fs::read(path).unwrap());
+        let (ok, _, err) = eenf(&args, d);
+        assert!(ok, "{args:?}: {err}");
+        let bytes = reader.join().unwrap();
+        assert!(bytes.starts_with(starts), "{args:?}");
+        assert!(
+            std::fs::metadata(&fifo).unwrap().file_type().is_fifo(),
+            "{args:?} replaced the FIFO"
+        );
+    }
+}

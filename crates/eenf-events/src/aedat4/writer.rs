@@ -241,7 +241,7 @@ impl Aedat4Writer {
             f.sync_all()
         })()
         .map_err(|e| io_err(&tmp, e))?;
-        std::fs::rename(&tmp, &self.path).map_err(|e| io_err(&self.path, e))?;
+        crate::commit_tmp(&tmp, &self.path).map_err(|e| io_err(&self.path, e))?;
         Ok(self.written)
     }
 }
