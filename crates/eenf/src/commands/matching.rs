@@ -19,7 +19,7 @@ use super::refdb::wav_start;
 /// Arguments of `eenf match`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The trace to place (CSV or JSON from `eenf extract`, `reference` or `video`).
+    /// The trace to place (CSV or JSON from `eenf extract` or `eenf reference`).
     pub trace: PathBuf,
     /// Where to look: a store from `eenf refdb build`, a folder of hourly mains WAVs, a WAV,
     /// or a trace CSV.
