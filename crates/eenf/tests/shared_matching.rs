@@ -8,16 +8,10 @@ use eenf_cli::pipeline::{reference_file, Nominal};
 use eenf_dsp::matching::{match_trace, MatchOptions, DEFAULT_ALPHA};
 use eenf_dsp::EnfParams;
 
+mod common;
+
 fn shared() -> PathBuf {
-    let dir = std::env::var_os("EENF_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    assert!(
-        dir.join("enf-traces-60hz").is_dir(),
-        "shared data not found at {}",
-        dir.display()
-    );
-    dir
+    common::shared("enf-traces-60hz")
 }
 
 fn day60(name: &str) -> Vec<f64> {

@@ -6,16 +6,10 @@ use std::path::PathBuf;
 use eenf_cli::pipeline::{reference_file, Nominal};
 use eenf_dsp::{EnfParams, PeakMethod};
 
+mod common;
+
 fn shared() -> PathBuf {
-    let dir = std::env::var_os("EENF_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    assert!(
-        dir.join("enf-reference").is_dir(),
-        "shared data not found at {} (set EENF_SHARED)",
-        dir.display()
-    );
-    dir
+    common::shared("enf-reference")
 }
 
 /// A 1-D little-endian float64 .npy file.

@@ -1,0 +1,17 @@
+//! Helpers shared by the test targets that need `../shared`.
+
+use std::path::PathBuf;
+
+/// The shared data folder (`EENF_SHARED`, else `../shared` beside the clone). Fails, not skips,
+/// when `sub` is not there: these tests only run where the data is meant to be.
+pub fn shared(sub: &str) -> PathBuf {
+    let dir = std::env::var_os("EENF_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
+    assert!(
+        dir.join(sub).is_dir(),
+        "shared data not found at {} (set EENF_SHARED)",
+        dir.display()
+    );
+    dir
+}
