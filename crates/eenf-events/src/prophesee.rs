@@ -139,9 +139,7 @@ impl WordDecoder for Evt2 {
                 },
                 // TIME_HIGH: t[33:6]; the 34-bit clock loops
                 0x8 => self.time_high = Some(self.unwrap.next((w & 0x0FFF_FFFF) as u64, 28) << 6),
-                0xA => self.skips.triggers += 1,
-                0xE | 0xF => self.skips.other += 1,
-                _ => self.skips.unknown += 1,
+                kind => self.skips.count_prophesee(kind as u64),
             }
         }
         Ok(())
@@ -190,9 +188,7 @@ impl WordDecoder for Evt21 {
                     None => self.skips.before_time += 1,
                 },
                 0x8 => self.time_high = Some(self.unwrap.next((w >> 32) & 0x0FFF_FFFF, 28) << 6),
-                0xA => self.skips.triggers += 1,
-                0xE | 0xF => self.skips.other += 1,
-                _ => self.skips.unknown += 1,
+                kind => self.skips.count_prophesee(kind),
             }
         }
         Ok(())

@@ -305,6 +305,16 @@ pub(crate) struct Skips {
 }
 
 impl Skips {
+    /// Counts a Prophesee word type that is not an event or a time word: 0xA external
+    /// trigger, 0xE/0xF others and continuations, anything else unknown.
+    pub(crate) fn count_prophesee(&mut self, kind: u64) {
+        match kind {
+            0xA => self.triggers += 1,
+            0xE | 0xF => self.other += 1,
+            _ => self.unknown += 1,
+        }
+    }
+
     pub(crate) fn list(&self) -> Vec<(&'static str, u64)> {
         [
             ("trigger", self.triggers),

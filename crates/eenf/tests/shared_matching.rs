@@ -22,13 +22,7 @@ fn day60(name: &str) -> Vec<f64> {
 }
 
 fn hours50() -> Vec<f64> {
-    let dir = shared().join("enf-reference");
-    let mut wavs: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().map(|e| e == "wav").unwrap_or(false))
-        .collect();
-    wavs.sort();
+    let wavs = common::reference_wavs();
     let mut all = Vec::new();
     for w in wavs {
         let (_, t) = reference_file(&w, Nominal::Hz(50.0), &EnfParams::default()).unwrap();

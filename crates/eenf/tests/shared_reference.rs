@@ -28,13 +28,7 @@ fn read_npy(path: &std::path::Path) -> Vec<f64> {
 #[test]
 #[ignore = "needs ../shared"]
 fn six_real_hours_match_the_datasets_own_references() {
-    let dir = shared().join("enf-reference");
-    let mut wavs: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().map(|e| e == "wav").unwrap_or(false))
-        .collect();
-    wavs.sort();
+    let wavs = common::reference_wavs();
     assert_eq!(wavs.len(), 6);
     for wav in &wavs {
         let params = EnfParams {

@@ -15,3 +15,15 @@ pub fn shared(sub: &str) -> PathBuf {
     );
     dir
 }
+
+/// The shared hourly mains recordings (`enf-reference/*.wav`), sorted by name (= by time).
+pub fn reference_wavs() -> Vec<PathBuf> {
+    let dir = shared("enf-reference").join("enf-reference");
+    let mut wavs: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().map(|e| e == "wav").unwrap_or(false))
+        .collect();
+    wavs.sort();
+    wavs
+}
