@@ -104,43 +104,75 @@ impl SyntheticEnf {
 
 const PHASE_FS: f64 = 1000.0;
 
+/// Catmull-Rom interpolation of `v` at fractional index `x` (clamped at both ends).
+fn spline_at(v: &[f64], x: f64) -> f64 {
+    if v.len() < 2 {
+        return v.first().copied().unwrap_or(0.0);
+    }
+    let last = v.len() - 1;
+    let x = x.clamp(0.0, last as f64);
+    let i = (x.floor() as usize).min(last - 1);
+    let u = x - i as f64;
+    let p = |k: isize| v[(i as isize + k).clamp(0, last as isize) as usize];
+    let (p0, p1, p2, p3) = (p(-1), p(0), p(1), p(2));
+    p1 + 0.5
+        * u
+        * (p2 - p0 + u * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + u * (3.0 * (p1 - p2) + p3 - p0)))
+}
+
 impl MainsPhase {
     /// A wandering ENF from the synthetic process, linearly interpolated between seconds and
     /// integrated into phase.
     pub fn synthetic(nominal_hz: f64, duration_s: f64, stats: SyntheticEnf, seed: u64) -> Self {
         let per_second = stats.per_second(nominal_hz, duration_s.ceil() as usize + 2, seed);
         let phase0 = (seed % 6283) as f64 * 1e-3;
-        Self::from_frequency(nominal_hz, &per_second, 1.0, duration_s, phase0)
+        Self::from_frequency(nominal_hz, &per_second, 1.0, 0.0, duration_s, phase0)
     }
 
-    /// Integrates a frequency trace given every `step_s` seconds (linear in between).
+    /// Integrates a frequency trace given every `step_s` seconds, from `t0_s` seconds after its
+    /// first value, for `duration_s`. Between values the frequency follows a Catmull-Rom
+    /// spline, so it moves smoothly (no corners every step); the same trace and `t0_s` always
+    /// give the same frequency, so a recording and an hour-long reference cut from one trace
+    /// agree.
     pub fn from_frequency(
         nominal_hz: f64,
         freq_hz: &[f64],
         step_s: f64,
+        t0_s: f64,
         duration_s: f64,
         phase0: f64,
     ) -> Self {
         let n = (duration_s * PHASE_FS).ceil() as usize + 2;
         let mut phase = Vec::with_capacity(n);
         let mut acc = phase0;
-        let f_at = |t: f64| {
-            let x = t / step_s;
-            let i = (x.floor() as usize).min(freq_hz.len().saturating_sub(2));
-            let frac = (x - i as f64).clamp(0.0, 1.0);
-            freq_hz[i] * (1.0 - frac) + freq_hz[(i + 1).min(freq_hz.len() - 1)] * frac
-        };
+        let f_at = |t: f64| spline_at(freq_hz, (t0_s + t) / step_s);
+        let mut f_prev = f_at(0.0);
         for i in 0..n {
             phase.push(acc);
             // trapezoid over one phase sample
-            let t = i as f64 / PHASE_FS;
-            acc += 2.0 * PI * 0.5 * (f_at(t) + f_at(t + 1.0 / PHASE_FS)) / PHASE_FS;
+            let f_next = f_at((i + 1) as f64 / PHASE_FS);
+            acc += 2.0 * PI * 0.5 * (f_prev + f_next) / PHASE_FS;
+            f_prev = f_next;
         }
         MainsPhase {
             fs: PHASE_FS,
             phase,
             nominal_hz,
         }
+    }
+
+    /// The mains voltage as a sound card records it through a transformer: `fs` samples per
+    /// second of cos φ with a little 3rd-harmonic distortion and noise, scaled to ±0.6.
+    pub fn voltage(&self, fs: f64, seed: u64) -> Vec<f64> {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let n = (self.duration_s() * fs).floor() as usize;
+        (0..n)
+            .map(|i| {
+                let phi = self.phase_at(i as f64 / fs);
+                let noise: f64 = rng.sample(StandardNormal);
+                0.6 * (phi.cos() + 0.04 * (3.0 * phi + 0.3).cos()) + 0.004 * noise
+            })
+            .collect()
     }
 
     /// The phase of a recorded mains signal `x` (sampled at `fs`) from `start_s` for

@@ -32,6 +32,65 @@ impl StartTime {
     pub fn date(&self) -> String {
         format!("{:04}_{:02}_{:02}", self.year, self.month, self.day)
     }
+
+    /// The wall-clock time `seconds` after 1970-01-01 00:00 (local time, no zone).
+    pub fn from_local_seconds(seconds: i64) -> Self {
+        let days = seconds.div_euclid(86_400);
+        let sod = seconds.rem_euclid(86_400) as u32;
+        // civil from days (Howard Hinnant's algorithm)
+        let z = days + 719_468;
+        let era = z.div_euclid(146_097);
+        let doe = z - era * 146_097;
+        let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+        let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+        let mp = (5 * doy + 2) / 153;
+        let day = (doy - (153 * mp + 2) / 5 + 1) as u32;
+        let month = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+        let year = (yoe + era * 400 + i64::from(month <= 2)) as u32;
+        StartTime {
+            year,
+            month,
+            day,
+            hour: sod / 3600,
+            minute: sod / 60 % 60,
+            second: sod % 60,
+        }
+    }
+
+    /// Seconds after 1970-01-01 00:00 of this wall-clock time.
+    pub fn local_seconds(&self) -> i64 {
+        crate::pipeline::days_from_civil(self.year as i64, self.month, self.day) * 86_400
+            + (self.hour * 3600 + self.minute * 60 + self.second) as i64
+    }
+
+    /// `Mon`…`Sun`.
+    pub fn weekday(&self) -> &'static str {
+        let days = crate::pipeline::days_from_civil(self.year as i64, self.month, self.day);
+        // 1970-01-01 was a Thursday
+        ["Thu", "Fri", "Sat", "Sun", "Mon", "Tue", "Wed"][days.rem_euclid(7) as usize]
+    }
+
+    /// The dataset's recording name, `dvSave-YYYY_MM_DD_HH_MM_SS.<ext>`.
+    pub fn recording_name(&self, ext: &str) -> String {
+        format!(
+            "dvSave-{}_{:02}_{:02}_{:02}.{ext}",
+            self.date(),
+            self.hour,
+            self.minute,
+            self.second
+        )
+    }
+
+    /// The dataset's name of the hourly reference holding this time,
+    /// `YYYY_MM_DD_Day_HH_00_00.wav`.
+    pub fn reference_name(&self) -> String {
+        format!(
+            "{}_{}_{:02}_00_00.wav",
+            self.date(),
+            self.weekday(),
+            self.hour
+        )
+    }
 }
 
 /// Finds `dvSave-YYYY_MM_DD_HH_MM_SS` in a path's file name.
@@ -121,5 +180,20 @@ mod tests {
         let r = reference_hour(Path::new("x/2022_08_17_Wed_17_00_00.wav")).unwrap();
         assert_eq!((r.day, r.hour, r.minute), (17, 17, 0));
         assert!(reference_hour(Path::new("notes.wav")).is_none());
+        // names made from times read back as those times
+        let t = StartTime::from_local_seconds(r.local_seconds() + 754);
+        assert_eq!(
+            t.recording_name("aedat4"),
+            "dvSave-2022_08_17_17_12_34.aedat4"
+        );
+        assert_eq!(t.reference_name(), "2022_08_17_Wed_17_00_00.wav");
+        let leap = StartTime::from_local_seconds(
+            crate::pipeline::days_from_civil(2024, 2, 29) * 86_400 + 3661,
+        );
+        assert_eq!(
+            (leap.month, leap.day, leap.hour, leap.minute),
+            (2, 29, 1, 1)
+        );
+        assert_eq!(leap.weekday(), "Thu");
     }
 }

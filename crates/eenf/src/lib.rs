@@ -12,4 +12,5 @@ pub mod pipeline;
 pub mod plot;
 pub mod progress;
 pub mod refdb;
+pub mod simulation;
 pub mod wav;

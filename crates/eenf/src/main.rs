@@ -40,6 +40,9 @@ enum Command {
     Match(commands::matching::Args),
     /// Simulate an event recording of a flickering scene, with its ground-truth ENF.
     Simulate(commands::simulate::Args),
+    /// Simulate a whole EV-ENFD-like dataset: static, dynamic and extreme recordings with
+    /// hourly mains references.
+    SimulateDataset(commands::simulate_dataset::Args),
     /// Simulate 60 s, extract the ENF, compare it with the truth: the whole method in one go.
     Demo(commands::demo::Args),
 }
@@ -56,6 +59,7 @@ fn main() -> ExitCode {
         Command::Refdb(c) => commands::refdb::run(c, progress),
         Command::Match(a) => commands::matching::run(a, progress),
         Command::Simulate(a) => commands::simulate::run(a, progress).map(|_| ()),
+        Command::SimulateDataset(a) => commands::simulate_dataset::run(a, progress),
         Command::Demo(a) => commands::demo::run(a, progress),
     };
     match result {

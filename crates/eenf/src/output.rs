@@ -141,24 +141,54 @@ pub fn times(n: usize, step: f64) -> Vec<f64> {
 pub fn utc_string(us: i64) -> String {
     let secs = us.div_euclid(1_000_000);
     let micros = us.rem_euclid(1_000_000);
-    let days = secs.div_euclid(86_400);
-    let sod = secs.rem_euclid(86_400);
-    // civil_from_days (Howard Hinnant's algorithm)
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
+    let t = crate::dataset::StartTime::from_local_seconds(secs);
     format!(
-        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}.{micros:06}Z",
-        sod / 3600,
-        sod % 3600 / 60,
-        sod % 60
+        "{:04}-{:02}-{:02}T{:02}:{:02}:{:02}.{micros:06}Z",
+        t.year, t.month, t.day, t.hour, t.minute, t.second
     )
+}
+
+/// A two-column CSV: `time_s,enf_hz` (eenf traces) or `index,value` (needs `step`).
+pub fn read_series_csv(path: &Path, step: Option<f64>) -> Result<(f64, Vec<f64>)> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+    let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
+    if header.contains("time_s") {
+        let t = read_trace(path)?;
+        let step = if t.time_s.len() > 1 {
+            t.time_s[1] - t.time_s[0]
+        } else {
+            1.0
+        };
+        return Ok((step, t.enf_hz));
+    }
+    let step = step.with_context(|| format!("{}: an index CSV needs --step", path.display()))?;
+    // a header row is one whose first field is not a number
+    let skip = usize::from(
+        text.lines()
+            .next()
+            .and_then(|l| l.split(',').next())
+            .map(|f| f.trim().parse::<f64>().is_err())
+            .unwrap_or(false),
+    );
+    let mut vals = Vec::new();
+    for (i, line) in text.lines().skip(skip).enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let v = line
+            .split(',')
+            .nth(1)
+            .and_then(|v| v.trim().parse::<f64>().ok())
+            .with_context(|| {
+                format!(
+                    "{}: line {}: expected index,value",
+                    path.display(),
+                    i + 1 + skip
+                )
+            })?;
+        vals.push(v);
+    }
+    Ok((step, vals))
 }
 
 #[cfg(test)]

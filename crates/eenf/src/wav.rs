@@ -93,3 +93,13 @@ pub fn write_wav(path: &Path, fs: u32, samples: &[f64]) -> Result<()> {
         }
     }
 }
+
+/// True when `path` starts like a RIFF/WAVE file.
+pub fn is_wav(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 12];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .map(|_| &head[..4] == b"RIFF" && &head[8..12] == b"WAVE")
+        .unwrap_or(false)
+}

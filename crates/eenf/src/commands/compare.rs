@@ -1,6 +1,5 @@
 //! `eenf compare`: agreement of an ENF trace with a reference.
 
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -9,6 +8,7 @@ use eenf_cli::output::{read_trace, times, TraceFile};
 use eenf_cli::pipeline::{align, reference_file, reference_for_recording, Nominal};
 use eenf_cli::plot::plot_comparison;
 use eenf_cli::progress::Progress;
+use eenf_cli::wav::is_wav;
 use eenf_dsp::{agreement, Agreement, EnfParams};
 
 use super::method::Peak;
@@ -49,14 +49,6 @@ pub struct Comparison {
     pub estimate: Vec<f64>,
     /// Reference at those times.
     pub reference: Vec<f64>,
-}
-
-fn is_wav(path: &Path) -> bool {
-    let mut head = [0u8; 12];
-    std::fs::File::open(path)
-        .and_then(|mut f| f.read_exact(&mut head))
-        .map(|_| &head[..4] == b"RIFF" && &head[8..12] == b"WAVE")
-        .unwrap_or(false)
 }
 
 /// The estimate's peak method, from its JSON metadata.

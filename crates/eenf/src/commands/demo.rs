@@ -36,13 +36,9 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let sim = simulate::run(
         simulate::Args {
             duration: a.duration,
-            enf: "synthetic".into(),
-            grid: 50,
             output: recording.clone(),
-            resolution: "64x48".into(),
             seed: a.seed,
-            compression: "lz4".into(),
-            format: None,
+            ..simulate::Args::default()
         },
         progress,
     )?;

@@ -10,3 +10,4 @@ pub mod method;
 pub mod refdb;
 pub mod reference;
 pub mod simulate;
+pub mod simulate_dataset;

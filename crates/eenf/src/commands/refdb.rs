@@ -4,10 +4,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use eenf_cli::dataset::reference_hour;
-use eenf_cli::output::read_trace;
+use eenf_cli::output::read_series_csv;
 use eenf_cli::pipeline::{days_from_civil, reference_file, Nominal};
 use eenf_cli::progress::Progress;
 use eenf_cli::refdb::{parse_time, tz_offset, utc, RefSeries, GAP};
+use eenf_cli::wav::is_wav;
 use eenf_dsp::EnfParams;
 
 /// `eenf refdb` subcommands.
@@ -59,58 +60,6 @@ fn nominal_of(values: &[f64], what: &str) -> Result<f64> {
         .with_context(|| format!("{what}: mean {mean:.3} Hz is neither a 50 nor a 60 Hz grid"))
 }
 
-/// A two-column CSV: `time_s,enf_hz` (eenf traces) or `index,value` (needs `step`).
-fn read_csv(path: &Path, step: Option<f64>) -> Result<(f64, Vec<f64>)> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-    let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
-    if header.contains("time_s") {
-        let t = read_trace(path)?;
-        let step = if t.time_s.len() > 1 {
-            t.time_s[1] - t.time_s[0]
-        } else {
-            1.0
-        };
-        return Ok((step, t.enf_hz));
-    }
-    let step = step.with_context(|| format!("{}: an index CSV needs --step", path.display()))?;
-    // a header row is one whose first field is not a number
-    let skip = usize::from(
-        text.lines()
-            .next()
-            .and_then(|l| l.split(',').next())
-            .map(|f| f.trim().parse::<f64>().is_err())
-            .unwrap_or(false),
-    );
-    let mut vals = Vec::new();
-    for (i, line) in text.lines().skip(skip).enumerate() {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let v = line
-            .split(',')
-            .nth(1)
-            .and_then(|v| v.trim().parse::<f64>().ok())
-            .with_context(|| {
-                format!(
-                    "{}: line {}: expected index,value",
-                    path.display(),
-                    i + 1 + skip
-                )
-            })?;
-        vals.push(v);
-    }
-    Ok((step, vals))
-}
-
-fn is_wav(path: &Path) -> bool {
-    use std::io::Read;
-    let mut h = [0u8; 12];
-    std::fs::File::open(path)
-        .and_then(|mut f| f.read_exact(&mut h))
-        .map(|_| &h[..4] == b"RIFF" && &h[8..] == b"WAVE")
-        .unwrap_or(false)
-}
-
 /// Unix time of an hourly reference's name in local time at `tz`.
 pub fn wav_start(path: &Path, tz: f64) -> Result<f64> {
     let t = reference_hour(path).with_context(|| {
@@ -137,7 +86,7 @@ fn build(a: BuildArgs, progress: Progress) -> Result<()> {
             let (_, trace) = reference_file(&path, Nominal::Auto, &EnfParams::default())?;
             (at.unwrap_or(wav_start(&path, tz)?), 1.0, trace)
         } else {
-            let (step, values) = read_csv(&path, a.step)?;
+            let (step, values) = read_series_csv(&path, a.step)?;
             let start = at.or(next_start).with_context(|| {
                 format!(
                     "{}: give its start as FILE@TIME or with --start",

@@ -3,30 +3,45 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use eenf_cli::output::{times, write_atomic, write_trace_csv};
-use eenf_cli::pipeline::{mains_nominal, Nominal};
+use eenf_cli::dataset::recording_start;
 use eenf_cli::progress::Progress;
-use eenf_cli::wav::read_wav;
-use eenf_events::writers::{create, OutputFormat};
+use eenf_cli::refdb::{parse_time, tz_offset};
+use eenf_cli::simulation::{write_recording, EnfTimeline, Simulated};
+use eenf_cli::wav::is_wav;
+use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;
-use eenf_sim::{simulate, MainsPhase, SimConfig, SimStats, SyntheticEnf};
+use eenf_sim::{Lamp, Readout, SceneKind, SimConfig};
+
+pub use eenf_cli::simulation::sibling;
 
 /// Arguments of `eenf simulate`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
+    /// Scene classes, comma-separated (mixes allowed): static, dynamic-object,
+    /// dynamic-camera, extreme-dim, extreme-bright.
+    #[arg(long, default_value = "static")]
+    pub scene: String,
+    /// Lamps, comma-separated (at most 3), each KIND[@PHASE_DEG][*SHARE] with KIND one of
+    /// incandescent, fluorescent, led, sinusoid; e.g. `led,fluorescent@120`.
+    #[arg(long, default_value = "led")]
+    pub lamp: String,
     /// Length of the recording, s.
     #[arg(long, default_value_t = 60.0)]
     pub duration: f64,
-    /// Where the ENF comes from: `synthetic` (a grid-like random process) or a mains WAV,
-    /// optionally with a start second (`ref.wav:600`).
+    /// Where the ENF comes from: `synthetic` (a grid-like random process), a mains WAV or a
+    /// trace CSV (`time_s,enf_hz`, or `index,value` at --enf-step), optionally with a start
+    /// second (`ref.wav:600`).
     #[arg(long, default_value = "synthetic")]
     pub enf: String,
-    /// Grid frequency of a synthetic ENF: 50 or 60 (a WAV's own is detected).
+    /// Seconds between the values of an `index,value` trace CSV.
+    #[arg(long, default_value_t = 2.0)]
+    pub enf_step: f64,
+    /// Grid frequency of a synthetic ENF: 50 or 60 (a WAV's or trace's own is detected).
     #[arg(long, default_value_t = 50)]
     pub grid: u32,
     /// Output recording; the format follows the extension (.aedat4, .raw = EVT 3.0, .dat,
-    /// .txt) unless --format says. The truth goes beside it as NAME.truth.csv, the parameters
-    /// as NAME.sim.json.
+    /// .txt) unless --format says. The truth goes beside it as NAME.truth.csv, every
+    /// parameter as NAME.sim.json.
     #[arg(short, long, default_value = "simulated.aedat4")]
     pub output: PathBuf,
     /// Sensor resolution WxH.
@@ -35,6 +50,24 @@ pub struct Args {
     /// Random seed (same seed, same recording).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Readout: dvxplorer (scans, shared timestamps, finite bandwidth) or prophesee (µs
+    /// timestamps).
+    #[arg(long, default_value = "dvxplorer")]
+    pub readout: String,
+    /// Overall light level (1 = indoor room); the scene classes set their own.
+    #[arg(long)]
+    pub illumination: Option<f64>,
+    /// Share of non-flickering light (daylight), 0..1.
+    #[arg(long)]
+    pub ambient: Option<f64>,
+    /// Local start time of the recording (names, timestamps; a WAV or CSV source named with
+    /// its time sets it).
+    #[arg(long, default_value = "2022-08-17T16:10:00+08:00")]
+    pub start: String,
+    /// Also write the hourly mains references (400 Hz WAVs named like the dataset's) that
+    /// cover the recording into this folder.
+    #[arg(long)]
+    pub reference_dir: Option<PathBuf>,
     /// AEDAT4 packet compression: none, lz4, lz4_high, zstd, zstd_high.
     #[arg(long, default_value = "lz4")]
     pub compression: String,
@@ -43,23 +76,20 @@ pub struct Args {
     pub format: Option<String>,
 }
 
-/// Paths and numbers of a finished simulation.
-pub struct Simulated {
-    /// Its ground truth trace.
-    pub truth: PathBuf,
-    /// What was generated.
-    pub stats: SimStats,
-    /// Seconds it took.
-    pub seconds: f64,
+impl Default for Args {
+    fn default() -> Self {
+        use clap::Parser;
+        #[derive(clap::Parser)]
+        struct Wrap {
+            #[command(flatten)]
+            args: Args,
+        }
+        Wrap::parse_from(["simulate"]).args
+    }
 }
 
-/// NAME.ext → NAME.<suffix>
-pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
-    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
-    path.with_file_name(format!("{stem}.{suffix}"))
-}
-
-fn parse_resolution(s: &str) -> Result<(u16, u16)> {
+/// WxH → (W, H).
+pub fn parse_resolution(s: &str) -> Result<(u16, u16)> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .with_context(|| format!("--resolution {s:?}: expected WxH, e.g. 320x240"))?;
@@ -77,54 +107,121 @@ fn parse_resolution(s: &str) -> Result<(u16, u16)> {
     Ok((w, h))
 }
 
-/// Builds the mains phase from `--enf`.
-fn mains(a: &Args) -> Result<MainsPhase> {
+/// `static,dynamic-object` → kinds.
+pub fn parse_scene(s: &str) -> Result<Vec<SceneKind>> {
+    s.split(',')
+        .map(|k| {
+            SceneKind::parse(k).with_context(|| {
+                format!(
+                    "--scene {k:?}: expected static, dynamic-object, dynamic-camera, extreme-dim \
+                     or extreme-bright"
+                )
+            })
+        })
+        .collect()
+}
+
+/// `led,fluorescent@120` → lamps.
+pub fn parse_lamps(s: &str) -> Result<Vec<Lamp>> {
+    let lamps: Vec<Lamp> = s
+        .split(',')
+        .map(|l| {
+            Lamp::parse(l).with_context(|| {
+                format!(
+                    "--lamp {l:?}: expected KIND[@PHASE_DEG][*SHARE] with KIND incandescent, \
+                     fluorescent, led or sinusoid"
+                )
+            })
+        })
+        .collect::<Result<_>>()?;
+    if lamps.len() > eenf_sim::MAX_LAMPS {
+        bail!("--lamp: at most {} lamps", eenf_sim::MAX_LAMPS);
+    }
+    Ok(lamps)
+}
+
+/// The local start time (seconds) and UTC offset of `--start`.
+fn local_start(a: &Args, source: Option<&Path>, source_start: f64) -> Result<(f64, f64)> {
+    let tz_part = a
+        .start
+        .rfind(['+', 'Z'])
+        .filter(|&i| i > 10)
+        .or_else(|| a.start.rfind('-').filter(|&i| i > 10))
+        .map(|i| &a.start[i..])
+        .unwrap_or("Z");
+    let tz = tz_offset(tz_part)?;
+    // a source named like the dataset's hourly references fixes the time
+    if let Some(t) = source.and_then(eenf_cli::dataset::reference_hour) {
+        return Ok((t.local_seconds() as f64 + source_start, tz));
+    }
+    let utc = parse_time(&a.start).with_context(|| "--start")?;
+    Ok((utc + tz, tz))
+}
+
+/// The timeline and the recording's local start.
+fn timeline(a: &Args) -> Result<(EnfTimeline, f64, f64)> {
     if a.enf == "synthetic" {
         if a.grid != 50 && a.grid != 60 {
             bail!("--grid must be 50 or 60");
         }
-        return Ok(MainsPhase::synthetic(
-            a.grid as f64,
-            a.duration,
-            SyntheticEnf::default(),
-            a.seed ^ 0x5eed,
-        ));
+        let (start, tz) = local_start(a, None, 0.0)?;
+        let t = EnfTimeline::synthetic(a.grid as f64, start, start + a.duration, a.seed ^ 0x5eed);
+        return Ok((t, start, tz));
     }
-    // WAV[:START]; a colon followed by a number is the start second
-    let (path, start) = match a.enf.rsplit_once(':') {
+    // PATH[:START]; a colon followed by a number is the start second
+    let (path, offset) = match a.enf.rsplit_once(':') {
         Some((p, s)) if s.parse::<f64>().is_ok() => (PathBuf::from(p), s.parse::<f64>()?),
         _ => (PathBuf::from(&a.enf), 0.0),
     };
-    let sig = read_wav(&path)?;
-    let f0 = mains_nominal(&sig, Nominal::Auto, &path)?;
-    MainsPhase::from_recording(&sig.samples, sig.fs, f0, start, a.duration)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+    if !path.exists() {
+        bail!("{}: no such file", path.display());
+    }
+    let (start, tz) = local_start(a, Some(&path), offset)?;
+    let t0 = start - offset;
+    let t = if is_wav(&path) {
+        EnfTimeline::wav(&path, t0)?
+    } else {
+        EnfTimeline::trace(&path, a.enf_step, t0)?
+    };
+    Ok((t, start, tz))
 }
 
-pub fn run(a: Args, progress: Progress) -> Result<Simulated> {
+/// The simulation configuration from the arguments.
+pub fn config(a: &Args, start_utc_us: i64) -> Result<SimConfig> {
     if !(a.duration > 0.0 && a.duration <= 24.0 * 3600.0) {
         bail!("--duration must be between 0 and 86400 s");
     }
     let (width, height) = parse_resolution(&a.resolution)?;
+    let readout = Readout::named(&a.readout)
+        .with_context(|| format!("--readout {:?}: expected dvxplorer or prophesee", a.readout))?;
+    let mut config = SimConfig {
+        width,
+        height,
+        duration_s: a.duration,
+        start_us: start_utc_us,
+        seed: a.seed,
+        lamps: parse_lamps(&a.lamp)?,
+        readout,
+        ..SimConfig::default()
+    }
+    .with_kinds(&parse_scene(&a.scene)?);
+    if let Some(i) = a.illumination {
+        config.illumination = i;
+    }
+    if let Some(x) = a.ambient {
+        config.ambient = x;
+    }
+    config.check().map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(config)
+}
+
+pub fn run(a: Args, progress: Progress) -> Result<Simulated> {
     let codec = Compression::parse(&a.compression).with_context(|| {
         format!(
             "--compression {:?}: expected none, lz4, lz4_high, zstd or zstd_high",
             a.compression
         )
     })?;
-    let started = std::time::Instant::now();
-    let mains = mains(&a)?;
-    let config = SimConfig {
-        width,
-        height,
-        duration_s: a.duration,
-        seed: a.seed,
-        ..SimConfig::default()
-    };
-    let bar = progress.steps(
-        (a.duration * 1e6 / config.scan_period_us as f64) as u64,
-        "simulating",
-    );
     let format = match &a.format {
         Some(f) => OutputFormat::parse(f, codec)
             .with_context(|| format!("--format {f:?}: expected aedat4, evt2, evt3, dat or text"))?,
@@ -132,38 +229,48 @@ pub fn run(a: Args, progress: Progress) -> Result<Simulated> {
             OutputFormat::from_extension(&a.output, codec).unwrap_or(OutputFormat::Aedat4(codec))
         }
     };
-    let mut writer = create(&a.output, format, width, height)?;
-    let stats = simulate(&config, &mains, |b| {
-        bar.inc(250);
-        writer.write(b).map_err(anyhow::Error::from)
-    })?;
-    writer.finish()?;
-    bar.finish_and_clear();
-    let truth = mains.truth(a.duration);
-    let truth_path = sibling(&a.output, "truth.csv");
-    write_atomic(&truth_path, |w| {
-        write_trace_csv(w, &times(truth.len(), 1.0), &truth)
-    })?;
-    let sidecar = serde_json::json!({
-        "recording": a.output, "truth": truth_path, "enf": a.enf,
-        "nominal_hz": mains.nominal_hz, "config": config, "stats": stats,
+    let (timeline, start, tz) = timeline(&a)?;
+    let config = config(&a, ((start - tz) * 1e6).round() as i64)?;
+    let mains = timeline.phase(start, a.duration)?;
+    let extra = serde_json::json!({
+        "enf": timeline.describe(),
+        "local_start": start,
+        "utc_offset_s": tz,
     });
-    write_atomic(&sibling(&a.output, "sim.json"), |w| {
-        serde_json::to_writer_pretty(&mut *w, &sidecar)?;
-        Ok(())
-    })?;
-    let seconds = started.elapsed().as_secs_f64();
+    let truth = timeline.truth(start, a.duration)?;
+    let sim = write_recording(&config, &mains, &truth, &a.output, format, extra, &progress)?;
     eprintln!(
-        "simulated {:.0} s at {width}x{height}: {} events ({:.1} M events/s generated) in {seconds:.1} s",
+        "simulated {:.0} s at {}x{}: {} events ({:.1} M events/s generated) in {:.1} s",
         a.duration,
-        stats.events,
-        stats.events as f64 / seconds / 1e6
+        config.width,
+        config.height,
+        sim.stats.events,
+        sim.stats.events as f64 / sim.seconds / 1e6,
+        sim.seconds
     );
+    if sim.stats.dropped_events + sim.stats.delayed_events > 0 {
+        eprintln!(
+            "readout: {} events delayed, {} dropped (bandwidth)",
+            sim.stats.delayed_events, sim.stats.dropped_events
+        );
+    }
     eprintln!("recording  {}", a.output.display());
-    eprintln!("truth      {}", truth_path.display());
-    Ok(Simulated {
-        truth: truth_path,
-        stats,
-        seconds,
-    })
+    eprintln!("truth      {}", sim.truth.display());
+    if let Some(dir) = &a.reference_dir {
+        let written = timeline.write_references(dir, start, start + a.duration, a.seed)?;
+        for p in written {
+            eprintln!("reference  {}", p.display());
+        }
+    }
+    // a recording named like the dataset's must carry its own start time
+    if let Some(t) = recording_start(&a.output) {
+        if (t.local_seconds() as f64 - start.floor()).abs() > 0.5 {
+            eprintln!(
+                "note: the name says {}, the recording starts at local second {:.0} of the day",
+                t.recording_name("…"),
+                start.rem_euclid(86_400.0)
+            );
+        }
+    }
+    Ok(sim)
 }

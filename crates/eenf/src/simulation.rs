@@ -1,0 +1,356 @@
+//! Simulated recordings on a wall-clock timeline: where their ENF comes from (a synthetic grid,
+//! a trace CSV, mains WAVs), the hourly reference WAVs that go with them, and writing one
+//! recording with its truth and parameters.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use eenf_events::writers::{create, OutputFormat};
+use eenf_sim::{simulate, MainsPhase, SimConfig, SimStats, SyntheticEnf};
+
+use crate::dataset::{hourly_references, StartTime};
+use crate::output::{read_series_csv, times, write_atomic, write_trace_csv};
+use crate::pipeline::{mains_nominal, Nominal};
+use crate::progress::Progress;
+use crate::wav::{read_wav, write_wav};
+
+/// Sampling rate of synthesized mains references (the dataset's).
+pub const REFERENCE_FS: u32 = 400;
+
+/// Where the ENF of simulated recordings comes from, on local wall-clock time (seconds since
+/// 1970-01-01 00:00 local).
+pub enum EnfTimeline {
+    /// A frequency series (synthetic, or read from a trace CSV) from `t0` at `step_s` steps.
+    Series {
+        /// Nominal frequency, Hz.
+        nominal_hz: f64,
+        /// Frequency values, Hz.
+        values: Vec<f64>,
+        /// Seconds between values.
+        step_s: f64,
+        /// Local time of the first value.
+        t0: f64,
+        /// What it is, for the sidecar.
+        source: String,
+    },
+    /// Mains recordings: hourly WAVs (or one WAV) starting at the given local times.
+    Mains {
+        /// Nominal frequency, Hz.
+        nominal_hz: f64,
+        /// (local start, path), sorted.
+        files: Vec<(f64, PathBuf)>,
+    },
+}
+
+impl EnfTimeline {
+    /// A synthetic grid covering `from..to` (local seconds), whole hours.
+    pub fn synthetic(nominal_hz: f64, from: f64, to: f64, seed: u64) -> Self {
+        let t0 = (from / 3600.0).floor() * 3600.0 - 2.0;
+        let n = ((to - t0) / 3600.0).ceil() as usize * 3600 + 8;
+        EnfTimeline::Series {
+            nominal_hz,
+            values: SyntheticEnf::default().per_second(nominal_hz, n, seed),
+            step_s: 1.0,
+            t0,
+            source: format!("synthetic {nominal_hz} Hz grid, seed {seed}"),
+        }
+    }
+
+    /// A trace CSV (`time_s,enf_hz`, or `index,value` at `step_s`) whose first value is at
+    /// local time `t0`.
+    pub fn trace(path: &Path, step_s: f64, t0: f64) -> Result<Self> {
+        let (step_s, values) = read_series_csv(path, Some(step_s))?;
+        if values.len() < 4 || values.iter().any(|v| !v.is_finite()) {
+            bail!("{}: a trace needs at least 4 finite values", path.display());
+        }
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        let nominal_hz = [50.0, 60.0]
+            .into_iter()
+            .find(|f| (mean - f).abs() < 1.0)
+            .with_context(|| {
+                format!(
+                    "{}: mean {mean:.3} Hz is neither a 50 nor a 60 Hz grid",
+                    path.display()
+                )
+            })?;
+        Ok(EnfTimeline::Series {
+            nominal_hz,
+            values,
+            step_s,
+            t0,
+            source: format!("trace {}", path.display()),
+        })
+    }
+
+    /// One mains WAV starting at local time `t0`.
+    pub fn wav(path: &Path, t0: f64) -> Result<Self> {
+        let sig = read_wav(path)?;
+        let nominal_hz = mains_nominal(&sig, Nominal::Auto, path)?;
+        Ok(EnfTimeline::Mains {
+            nominal_hz,
+            files: vec![(t0, path.to_path_buf())],
+        })
+    }
+
+    /// A folder of hourly mains WAVs named like the dataset's.
+    pub fn wav_dir(dir: &Path) -> Result<Self> {
+        let refs = hourly_references(dir)?;
+        let first = &refs[0].1;
+        let sig = read_wav(first)?;
+        let nominal_hz = mains_nominal(&sig, Nominal::Auto, first)?;
+        Ok(EnfTimeline::Mains {
+            nominal_hz,
+            files: refs
+                .into_iter()
+                .map(|(t, p)| (t.local_seconds() as f64, p))
+                .collect(),
+        })
+    }
+
+    /// Nominal frequency, Hz.
+    pub fn nominal_hz(&self) -> f64 {
+        match self {
+            EnfTimeline::Series { nominal_hz, .. } | EnfTimeline::Mains { nominal_hz, .. } => {
+                *nominal_hz
+            }
+        }
+    }
+
+    /// Local times covered, `(from, to)`.
+    pub fn coverage(&self) -> Result<(f64, f64)> {
+        Ok(match self {
+            EnfTimeline::Series {
+                values, step_s, t0, ..
+            } => (
+                *t0 + 2.0 * step_s,
+                t0 + (values.len() as f64 - 3.0) * step_s,
+            ),
+            EnfTimeline::Mains { files, .. } => {
+                // contiguous run of files from the first
+                let mut end = files[0].0;
+                for (t, p) in files {
+                    if (*t - end).abs() > 1.0 {
+                        break;
+                    }
+                    let reader = hound::WavReader::open(p)
+                        .with_context(|| format!("{}: not a readable WAV", p.display()))?;
+                    end = t + reader.duration() as f64 / reader.spec().sample_rate as f64;
+                }
+                (files[0].0, end)
+            }
+        })
+    }
+
+    /// The mains phase of `duration_s` seconds from local time `start`.
+    pub fn phase(&self, start: f64, duration_s: f64) -> Result<MainsPhase> {
+        match self {
+            EnfTimeline::Series {
+                nominal_hz,
+                values,
+                step_s,
+                t0,
+                ..
+            } => {
+                let (from, to) = self.coverage()?;
+                if start < from || start + duration_s > to {
+                    bail!(
+                        "the ENF trace covers {:.0} s; {:.0} s from second {:.0} do not fit",
+                        to - from,
+                        duration_s,
+                        start - from
+                    );
+                }
+                // the phase runs on from the series' start, so pieces cut from one series fit
+                Ok(MainsPhase::from_frequency(
+                    *nominal_hz,
+                    values,
+                    *step_s,
+                    start - t0,
+                    duration_s,
+                    0.0,
+                ))
+            }
+            EnfTimeline::Mains { nominal_hz, files } => {
+                // the files holding [start, start + duration], read and joined
+                let end = start + duration_s;
+                let mut samples = Vec::new();
+                let mut fs = 0.0;
+                let mut first_t: Option<f64> = None;
+                for (t, p) in files {
+                    let sig = read_wav(p)?;
+                    let file_end = t + sig.samples.len() as f64 / sig.fs;
+                    if file_end <= start - 20.0 || *t >= end + 20.0 {
+                        continue;
+                    }
+                    if fs != 0.0 && sig.fs != fs {
+                        bail!("{}: its rate differs from the previous file's", p.display());
+                    }
+                    if let Some(ft) = first_t {
+                        let expected = ft + samples.len() as f64 / fs;
+                        if (t - expected).abs() > 1.0 {
+                            bail!("{}: there is a gap before this file", p.display());
+                        }
+                    } else {
+                        first_t = Some(*t);
+                    }
+                    fs = sig.fs;
+                    samples.extend_from_slice(&sig.samples);
+                }
+                let Some(ft) = first_t else {
+                    bail!("no mains recording covers local time {start:.0} s");
+                };
+                MainsPhase::from_recording(&samples, fs, *nominal_hz, start - ft, duration_s)
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", files[0].1.display()))
+            }
+        }
+    }
+
+    /// The true ENF of `duration_s` seconds from local time `start`, one value per second: the
+    /// reference tracker on the clean mains voltage of the recording's span, its windows
+    /// zero-padded at the ends as an estimator that sees only the recording has them, so that
+    /// a perfect estimator scores MAE ≈ 0. (A reference recorded around the recording differs
+    /// at the first and last ~8 s, where its windows see the mains outside the recording.)
+    pub fn truth(&self, start: f64, duration_s: f64) -> Result<Vec<f64>> {
+        Ok(self.phase(start, duration_s)?.truth(duration_s))
+    }
+
+    /// What drives the ENF, for the sidecar.
+    pub fn describe(&self) -> String {
+        match self {
+            EnfTimeline::Series { source, .. } => source.clone(),
+            EnfTimeline::Mains { files, .. } => {
+                let names: Vec<String> = files.iter().map(|f| f.1.display().to_string()).collect();
+                format!("mains {}", names.join(", "))
+            }
+        }
+    }
+
+    /// Writes the hourly reference WAVs (400 Hz, 16-bit, named like the dataset's) into `dir`:
+    /// those covering `from..to` synthesized from a series, or every mains recording copied.
+    pub fn write_references(
+        &self,
+        dir: &Path,
+        from: f64,
+        to: f64,
+        seed: u64,
+    ) -> Result<Vec<PathBuf>> {
+        std::fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
+        let mut out = Vec::new();
+        match self {
+            EnfTimeline::Series { .. } => {
+                let (have_from, have_to) = self.coverage()?;
+                let mut hour = (from / 3600.0).floor() * 3600.0;
+                if hour < have_from || (to / 3600.0).ceil() * 3600.0 > have_to {
+                    bail!(
+                        "hourly references need the ENF of whole hours; the trace covers {:.0} s",
+                        have_to - have_from
+                    );
+                }
+                while hour < to {
+                    let name = StartTime::from_local_seconds(hour as i64).reference_name();
+                    let path = dir.join(name);
+                    let phase = self.phase(hour, 3600.0)?;
+                    write_wav(
+                        &path,
+                        REFERENCE_FS,
+                        &phase.voltage(REFERENCE_FS as f64, seed ^ hour as u64),
+                    )?;
+                    out.push(path);
+                    hour += 3600.0;
+                }
+            }
+            EnfTimeline::Mains { files, .. } => {
+                // all of them: they are the dataset's references
+                for (_, p) in files {
+                    let name = p.file_name().context("a reference without a file name")?;
+                    let dest = dir.join(name);
+                    if dest != *p {
+                        let tmp = dest.with_extension("wav.tmp");
+                        std::fs::copy(p, &tmp).with_context(|| format!("{}", dest.display()))?;
+                        std::fs::rename(&tmp, &dest)
+                            .with_context(|| format!("{}", dest.display()))?;
+                    }
+                    out.push(dest);
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// A finished simulated recording.
+pub struct Simulated {
+    /// The event file.
+    pub recording: PathBuf,
+    /// Its ground-truth trace.
+    pub truth: PathBuf,
+    /// What was generated.
+    pub stats: SimStats,
+    /// Seconds it took.
+    pub seconds: f64,
+}
+
+/// NAME.ext → NAME.<suffix>
+pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    path.with_file_name(format!("{stem}.{suffix}"))
+}
+
+/// Simulates `config` under `mains` into `output` (format `format`), with `truth` beside it
+/// as NAME.truth.csv and every parameter as NAME.sim.json. `extra` joins the sidecar.
+pub fn write_recording(
+    config: &SimConfig,
+    mains: &MainsPhase,
+    truth: &[f64],
+    output: &Path,
+    format: OutputFormat,
+    extra: serde_json::Value,
+    progress: &Progress,
+) -> Result<Simulated> {
+    config
+        .check()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", output.display()))?;
+    let started = std::time::Instant::now();
+    let step_us = match config.readout {
+        eenf_sim::Readout::Dvxplorer { scan_period_us, .. } => scan_period_us,
+        eenf_sim::Readout::Prophesee { step_us, .. } => step_us,
+    }
+    .max(1);
+    let bar = progress.steps(
+        (config.duration_s * 1e6 / step_us as f64) as u64,
+        "simulating",
+    );
+    let mut writer = create(output, format, config.width, config.height)?;
+    let stats = simulate(config, mains, |b| {
+        bar.inc(250);
+        writer.write(b).map_err(anyhow::Error::from)
+    })?;
+    writer.finish()?;
+    bar.finish_and_clear();
+    let truth_path = sibling(output, "truth.csv");
+    write_atomic(&truth_path, |w| {
+        write_trace_csv(w, &times(truth.len(), 1.0), truth)
+    })?;
+    let seconds = started.elapsed().as_secs_f64();
+    let sidecar = serde_json::json!({
+        "recording": output,
+        "truth": truth_path,
+        "nominal_hz": mains.nominal_hz,
+        "seed": config.seed,
+        "config": config,
+        "stats": stats,
+        "seconds": seconds,
+        "eenf_version": env!("CARGO_PKG_VERSION"),
+        "extra": extra,
+    });
+    write_atomic(&sibling(output, "sim.json"), |w| {
+        serde_json::to_writer_pretty(&mut *w, &sidecar)?;
+        Ok(())
+    })?;
+    Ok(Simulated {
+        recording: output.to_path_buf(),
+        truth: truth_path,
+        stats,
+        seconds,
+    })
+}
