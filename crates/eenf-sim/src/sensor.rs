@@ -367,11 +367,16 @@ struct PixelState<'a> {
     keep_irradiance: bool,
 }
 
-/// Log, photoreceptor low-pass, leak and threshold comparison of every pixel; with AVX2 when
-/// the processor has it.
+/// Log, photoreceptor low-pass, leak and threshold comparison of every pixel; with AVX-512 or
+/// AVX2 when the processor has them (the same operations, so the same events).
 fn photoreceptor_pass(s: PixelState, light: &Light, pc: &PixelConsts) {
     #[cfg(target_arch = "x86_64")]
     {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the feature was detected at run time
+            unsafe { photoreceptor_avx512(s, light, pc) };
+            return;
+        }
         if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
         {
             // SAFETY: the features were detected at run time
@@ -379,6 +384,12 @@ fn photoreceptor_pass(s: PixelState, light: &Light, pc: &PixelConsts) {
             return;
         }
     }
+    photoreceptor_generic(s, light, pc)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx2,fma")]
+unsafe fn photoreceptor_avx512(s: PixelState, light: &Light, pc: &PixelConsts) {
     photoreceptor_generic(s, light, pc)
 }
 
