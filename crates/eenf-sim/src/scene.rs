@@ -204,6 +204,14 @@ struct Pose {
     roll: f64,
 }
 
+/// The camera pose and each object's state (position or angle) at one time.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    pose: Pose,
+    /// (object, x or angle, bob)
+    objects: Vec<(MovingObject, f64, f64)>,
+}
+
 /// Sum-of-sinusoids shake path: deterministic from the seed, cheap to evaluate anywhere.
 #[derive(Debug, Clone)]
 struct ShakePath {
@@ -481,6 +489,30 @@ impl Scene {
             .collect()
     }
 
+    /// Where the camera and the objects are at time `t`.
+    pub fn frame(&self, t: f64) -> Frame {
+        Frame {
+            pose: self.shake.as_ref().map(|s| s.at(t)).unwrap_or_default(),
+            objects: self
+                .config
+                .objects
+                .iter()
+                .map(|o| match *o {
+                    MovingObject::Walker {
+                        speed,
+                        width,
+                        phase_s,
+                        ..
+                    } => {
+                        let (x, bob) = Self::walker_pos(speed, width, phase_s, t);
+                        (*o, x, bob)
+                    }
+                    MovingObject::Fan { rev_per_s, .. } => (*o, 2.0 * PI * rev_per_s * t, 0.0),
+                })
+                .collect(),
+        }
+    }
+
     /// The light coefficients of the `n` pixels from `first` (row-major) at time `t`, written
     /// from `at` on: `out[k][at + j]` for lamp k, `out[MAX_LAMPS][at + j]` for daylight.
     pub fn render(
@@ -491,28 +523,23 @@ impl Scene {
         out: &mut [Vec<f32>; CHANNELS],
         at: usize,
     ) {
-        let pose = self.shake.as_ref().map(|s| s.at(t)).unwrap_or_default();
+        self.render_frame(&self.frame(t), first, n, out, at)
+    }
+
+    /// [`Scene::render`] for a frame already placed (one frame serves many pixel runs).
+    pub fn render_frame(
+        &self,
+        frame: &Frame,
+        first: usize,
+        n: usize,
+        out: &mut [Vec<f32>; CHANNELS],
+        at: usize,
+    ) {
+        let pose = frame.pose;
         let (w, h) = (self.width as f64, self.height as f64);
         let (cx, cy) = (w / 2.0, h / 2.0);
         let (sin_r, cos_r) = pose.roll.sin_cos();
-        // object states at t
-        let objects: Vec<(MovingObject, f64, f64)> = self
-            .config
-            .objects
-            .iter()
-            .map(|o| match *o {
-                MovingObject::Walker {
-                    speed,
-                    width,
-                    phase_s,
-                    ..
-                } => {
-                    let (x, bob) = Self::walker_pos(speed, width, phase_s, t);
-                    (*o, x, bob)
-                }
-                MovingObject::Fan { rev_per_s, .. } => (*o, 2.0 * PI * rev_per_s * t, 0.0),
-            })
-            .collect();
+        let objects = &frame.objects;
         for j in 0..n {
             let p = first + j;
             let (px, py) = ((p % self.width) as f64 + 0.5, (p / self.width) as f64 + 0.5);
@@ -531,7 +558,7 @@ impl Scene {
             let mut lamp_refl = refl; // what the lamps light (shadows fall here)
             let mut specular = 0.0;
             let mut covered = false;
-            for &(o, a, b) in &objects {
+            for &(o, a, b) in objects {
                 match o {
                     MovingObject::Walker {
                         width,

@@ -529,11 +529,12 @@ impl Chunk {
                 }
             }
             let mut target: [Vec<f32>; CHANNELS] = std::array::from_fn(|_| Vec::new());
+            let frame = scene.frame(t1);
             for &(start, len) in &self.moving {
                 for c in target.iter_mut() {
                     c.resize(len, 0.0);
                 }
-                scene.render(t1, self.first + start, len, &mut target, 0);
+                scene.render_frame(&frame, self.first + start, len, &mut target, 0);
                 for (c, tc) in target.iter().enumerate() {
                     let coef = &self.coef[c][start..start + len];
                     for ((d, t), c0) in self.delta[c][start..start + len]

@@ -132,9 +132,8 @@ impl EnfTimeline {
                     if (*t - end).abs() > 1.0 {
                         break;
                     }
-                    let reader = hound::WavReader::open(p)
-                        .with_context(|| format!("{}: not a readable WAV", p.display()))?;
-                    end = t + reader.duration() as f64 / reader.spec().sample_rate as f64;
+                    let (frames, rate) = wav_span(p)?;
+                    end = t + frames / rate;
                 }
                 (files[0].0, end)
             }
@@ -177,11 +176,12 @@ impl EnfTimeline {
                 let mut fs = 0.0;
                 let mut first_t: Option<f64> = None;
                 for (t, p) in files {
-                    let sig = read_wav(p)?;
-                    let file_end = t + sig.samples.len() as f64 / sig.fs;
-                    if file_end <= start - 20.0 || *t >= end + 20.0 {
+                    // the header says whether the file matters; only those are read
+                    let (frames, rate) = wav_span(p)?;
+                    if t + frames / rate <= start - 20.0 || *t >= end + 20.0 {
                         continue;
                     }
+                    let sig = read_wav(p)?;
                     if fs != 0.0 && sig.fs != fs {
                         bail!("{}: its rate differs from the previous file's", p.display());
                     }
@@ -203,15 +203,6 @@ impl EnfTimeline {
                     .map_err(|e| anyhow::anyhow!("{}: {e}", files[0].1.display()))
             }
         }
-    }
-
-    /// The true ENF of `duration_s` seconds from local time `start`, one value per second: the
-    /// reference tracker on the clean mains voltage of the recording's span, its windows
-    /// zero-padded at the ends as an estimator that sees only the recording has them, so that
-    /// a perfect estimator scores MAE ≈ 0. (A reference recorded around the recording differs
-    /// at the first and last ~8 s, where its windows see the mains outside the recording.)
-    pub fn truth(&self, start: f64, duration_s: f64) -> Result<Vec<f64>> {
-        Ok(self.phase(start, duration_s)?.truth(duration_s))
     }
 
     /// What drives the ENF, for the sidecar.
@@ -278,6 +269,13 @@ impl EnfTimeline {
     }
 }
 
+/// Frames and sampling rate of a WAV, from its header.
+fn wav_span(path: &Path) -> Result<(f64, f64)> {
+    let reader = hound::WavReader::open(path)
+        .with_context(|| format!("{}: not a readable WAV", path.display()))?;
+    Ok((reader.duration() as f64, reader.spec().sample_rate as f64))
+}
+
 /// A finished simulated recording.
 pub struct Simulated {
     /// The event file.
@@ -296,12 +294,16 @@ pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
     path.with_file_name(format!("{stem}.{suffix}"))
 }
 
-/// Simulates `config` under `mains` into `output` (format `format`), with `truth` beside it
+/// Simulates `config` under `mains` into `output` (format `format`), with the truth beside it
 /// as NAME.truth.csv and every parameter as NAME.sim.json. `extra` joins the sidecar.
+///
+/// The truth is `mains.truth(duration)`: the reference tracker on the clean mains of the
+/// recording's own span, its windows zero-padded at the ends as an estimator that sees only
+/// the recording has them, so that a perfect estimator scores MAE ≈ 0. (A reference recorded
+/// around the recording differs at the first and last ~8 s, where its windows see beyond it.)
 pub fn write_recording(
     config: &SimConfig,
     mains: &MainsPhase,
-    truth: &[f64],
     output: &Path,
     format: OutputFormat,
     extra: serde_json::Value,
@@ -327,9 +329,10 @@ pub fn write_recording(
     })?;
     writer.finish()?;
     bar.finish_and_clear();
+    let truth = mains.truth(config.duration_s);
     let truth_path = sibling(output, "truth.csv");
     write_atomic(&truth_path, |w| {
-        write_trace_csv(w, &times(truth.len(), 1.0), truth)
+        write_trace_csv(w, &times(truth.len(), 1.0), &truth)
     })?;
     let seconds = started.elapsed().as_secs_f64();
     let sidecar = serde_json::json!({

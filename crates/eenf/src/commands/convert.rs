@@ -23,16 +23,23 @@ pub struct Args {
     pub compression: String,
 }
 
+/// `--compression` → the AEDAT4 codec.
+pub fn parse_codec(s: &str) -> Result<Compression> {
+    Compression::parse(s).with_context(|| {
+        format!("--compression {s:?}: expected none, lz4, lz4_high, zstd or zstd_high")
+    })
+}
+
+/// `--format` → the output format.
+pub fn parse_format(f: &str, codec: Compression) -> Result<OutputFormat> {
+    OutputFormat::parse(f, codec)
+        .with_context(|| format!("--format {f:?}: expected aedat4, evt2, evt3, dat or text"))
+}
+
 pub fn run(a: Args, progress: Progress) -> Result<()> {
-    let codec = Compression::parse(&a.compression).with_context(|| {
-        format!(
-            "--compression {:?}: expected none, lz4, lz4_high, zstd or zstd_high",
-            a.compression
-        )
-    })?;
+    let codec = parse_codec(&a.compression)?;
     let format = match &a.format {
-        Some(f) => OutputFormat::parse(f, codec)
-            .with_context(|| format!("--format {f:?}: expected aedat4, evt2, evt3, dat or text"))?,
+        Some(f) => parse_format(f, codec)?,
         None => OutputFormat::from_extension(&a.output, codec).with_context(|| {
             format!(
                 "{}: cannot tell the output format from the name; pass --format aedat4|evt2|evt3|dat|text",

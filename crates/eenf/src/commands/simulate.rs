@@ -9,10 +9,11 @@ use eenf_cli::refdb::{parse_time, tz_offset};
 use eenf_cli::simulation::{write_recording, EnfTimeline, Simulated};
 use eenf_cli::wav::is_wav;
 use eenf_events::writers::OutputFormat;
-use eenf_events::Compression;
 use eenf_sim::{Lamp, Readout, SceneKind, SimConfig};
 
 pub use eenf_cli::simulation::sibling;
+
+use super::convert::{parse_codec, parse_format};
 
 /// Arguments of `eenf simulate`.
 #[derive(Debug, Clone, clap::Args)]
@@ -216,15 +217,9 @@ pub fn config(a: &Args, start_utc_us: i64) -> Result<SimConfig> {
 }
 
 pub fn run(a: Args, progress: Progress) -> Result<Simulated> {
-    let codec = Compression::parse(&a.compression).with_context(|| {
-        format!(
-            "--compression {:?}: expected none, lz4, lz4_high, zstd or zstd_high",
-            a.compression
-        )
-    })?;
+    let codec = parse_codec(&a.compression)?;
     let format = match &a.format {
-        Some(f) => OutputFormat::parse(f, codec)
-            .with_context(|| format!("--format {f:?}: expected aedat4, evt2, evt3, dat or text"))?,
+        Some(f) => parse_format(f, codec)?,
         None => {
             OutputFormat::from_extension(&a.output, codec).unwrap_or(OutputFormat::Aedat4(codec))
         }
@@ -237,8 +232,7 @@ pub fn run(a: Args, progress: Progress) -> Result<Simulated> {
         "local_start": start,
         "utc_offset_s": tz,
     });
-    let truth = timeline.truth(start, a.duration)?;
-    let sim = write_recording(&config, &mains, &truth, &a.output, format, extra, &progress)?;
+    let sim = write_recording(&config, &mains, &a.output, format, extra, &progress)?;
     eprintln!(
         "simulated {:.0} s at {}x{}: {} events ({:.1} M events/s generated) in {:.1} s",
         a.duration,

@@ -9,10 +9,10 @@ use eenf_cli::progress::Progress;
 use eenf_cli::refdb::tz_offset;
 use eenf_cli::simulation::{write_recording, EnfTimeline};
 use eenf_events::writers::OutputFormat;
-use eenf_events::Compression;
 use eenf_sim::{Lamp, LampKind, Readout, SceneKind, SimConfig};
 use rand::{Rng, SeedableRng};
 
+use super::convert::parse_codec;
 use super::simulate::parse_resolution;
 
 /// Arguments of `eenf simulate-dataset`.
@@ -162,8 +162,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let (width, height) = parse_resolution(a.resolution.as_deref().unwrap_or(preset_res))?;
     let readout = Readout::named(&a.readout)
         .with_context(|| format!("--readout {:?}: expected dvxplorer or prophesee", a.readout))?;
-    let codec = Compression::parse(&a.compression)
-        .with_context(|| format!("--compression {:?}: unknown", a.compression))?;
+    let codec = parse_codec(&a.compression)?;
     let tz = tz_offset(&a.tz)?;
 
     let timeline = match &a.enf_dir {
@@ -264,11 +263,9 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             "local_start": plan.local_start,
             "utc_offset_s": tz,
         });
-        let truth = timeline.truth(plan.local_start as f64, duration)?;
         let sim = write_recording(
             &plan.config,
             &mains,
-            &truth,
             &path,
             OutputFormat::Aedat4(codec),
             extra,
