@@ -245,6 +245,7 @@ fn score_at<R: ReferenceValues + ?Sized>(q: &[f64], r: &R, k: usize) -> (f64, f6
 
 /// A monotone stand-in for [`statistic`] that needs no logarithm, kept for every offset:
 /// CC itself, or (1 + CC) / ((1 − CC)·RMSE²), whose half logarithm is the combined score.
+#[inline]
 fn rank_key(score: Score, cc: f64, rmse: f64) -> f64 {
     let c = cc.clamp(-0.999_999, 0.999_999);
     match score {
@@ -309,27 +310,27 @@ fn scores_all<R: ReferenceValues + ?Sized>(
     out.par_chunks_mut(hop).enumerate().for_each_init(
         || {
             (
+                vec![f64::NAN; block],
                 fwd.make_input_vec(),
                 fwd.make_output_vec(),
                 fwd.make_scratch_vec(),
                 inv.make_scratch_vec(),
             )
         },
-        |(buf, spec, s1, s2), (bi, dst)| {
+        |(seg, buf, spec, s1, s2), (bi, dst)| {
             let start = bi * hop;
-            let end = (start + block).min(r.len());
-            let seg_len = end - start;
-            let at = |i: usize| {
-                if i < seg_len {
-                    r.get(start + i)
+            let seg_len = (start + block).min(r.len()) - start;
+            // the block's values relative to the reference mean, NaN for gaps and past the end
+            for (j, d) in seg.iter_mut().enumerate() {
+                *d = if j < seg_len {
+                    r.get(start + j) - r_mean
                 } else {
                     f64::NAN
-                }
-            };
+                };
+            }
             // gaps count as zero in the FFT; their windows are redone below
-            for (j, d) in buf.iter_mut().enumerate() {
-                let s = at(j);
-                *d = if s.is_finite() { s - r_mean } else { 0.0 };
+            for (d, &v) in buf.iter_mut().zip(seg.iter()) {
+                *d = if v.is_finite() { v } else { 0.0 };
             }
             fwd.process_with_scratch(buf, spec, s1)
                 .expect("sized by plan");
@@ -340,8 +341,7 @@ fn scores_all<R: ReferenceValues + ?Sized>(
                 .expect("sized by plan");
             // running window sums of r, r² and the gap count
             let (mut s, mut ss, mut gaps) = (0.0f64, 0.0f64, 0usize);
-            let value = |i: usize| at(i) - r_mean;
-            for v in (0..m).map(value) {
+            for &v in &seg[..m] {
                 if v.is_finite() {
                     s += v;
                     ss += v * v;
@@ -349,9 +349,10 @@ fn scores_all<R: ReferenceValues + ?Sized>(
                     gaps += 1;
                 }
             }
+            let inv_m = 1.0 / m as f64;
             for (k, o) in dst.iter_mut().enumerate() {
                 if k > 0 {
-                    let (old, new) = (value(k - 1), value(k + m - 1));
+                    let (old, new) = (seg[k - 1], seg[k + m - 1]);
                     if old.is_finite() {
                         s -= old;
                         ss -= old * old;
@@ -366,21 +367,18 @@ fn scores_all<R: ReferenceValues + ?Sized>(
                     }
                 }
                 let (cc, e) = if gaps == 0 {
-                    let var = ss - s * s / m as f64;
-                    let cc = if var > 0.0 {
-                        buf[k] / (q_norm * var.sqrt())
-                    } else {
-                        f64::NAN
-                    };
+                    let var = ss - s * s * inv_m;
+                    let cc = buf[k] / (q_norm * var.sqrt());
                     // Σ(q − r)² = Σq² − 2Σq·r + Σr², with Σq·r = Σ(q − q̄)·r + q̄·Σr
                     let sse = q_abs_sq - 2.0 * (buf[k] + q_mean * s) + ss;
-                    (cc, (sse.max(0.0) / m as f64).sqrt())
+                    (cc, (sse.max(0.0) * inv_m).sqrt())
                 } else if m - gaps >= min_valid {
                     let (cc, _, e, _) = score_at(&q_raw, r, start + k);
                     (cc, e)
                 } else {
                     (f64::NAN, f64::NAN)
                 };
+                // a flat window (var = 0) gives a non-finite CC and no score
                 *o = if cc.is_finite() && e.is_finite() {
                     rank_key(score, cc, e) as f32
                 } else {
@@ -450,47 +448,10 @@ pub fn match_trace<R: ReferenceValues + ?Sized>(
     let block_len = ((4.0 * corr_len).ceil() as usize)
         .max(trace.len() / 2)
         .max(10);
-    // best offsets: the top of each 64 Ki chunk (in cache, in parallel), then a global pick
-    // with the exclusion zones
-    let top_in = |base: usize, c: &[f32]| -> Vec<(usize, f32)> {
-        let mut mine: Vec<(usize, f32)> = Vec::new();
-        while mine.len() < opts.top {
-            let next = c
-                .iter()
-                .enumerate()
-                .filter(|(k, v)| {
-                    v.is_finite()
-                        && mine
-                            .iter()
-                            .all(|p| p.0.abs_diff(base + k) >= opts.exclusion)
-                })
-                .max_by(|a, b| a.1.total_cmp(b.1).then(b.0.cmp(&a.0)));
-            match next {
-                Some((k, v)) => mine.push((base + k, *v)),
-                None => break,
-            }
-        }
-        mine
-    };
-    let chunk = 1 << 16;
-    let mut local: Vec<(usize, f32)> = cc
-        .par_chunks(chunk)
-        .enumerate()
-        .flat_map_iter(|(i, c)| top_in(i * chunk, c))
-        .collect();
-    local.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-    let mut picked: Vec<usize> = Vec::new();
-    for (k, _) in local {
-        if picked.len() >= opts.top {
-            break;
-        }
-        if picked.iter().all(|p| p.abs_diff(k) >= opts.exclusion) {
-            picked.push(k);
-        }
-    }
+    let picked = best_offsets(&cc, opts.top, opts.exclusion);
     let best_at = picked.first().copied().unwrap_or(0);
     let maxima: Vec<f64> = cc
-        .chunks(block_len)
+        .par_chunks(block_len)
         .enumerate()
         // leave out the blocks near the best offset: they may hold the real match
         .filter(|(i, _)| {
@@ -569,6 +530,48 @@ pub fn match_trace<R: ReferenceValues + ?Sized>(
         tail_beta: tail.beta,
         tail_k: tail.k,
     })
+}
+
+/// The `top` best offsets by key, each at least `exclusion` away from every better one
+/// (greedy, ties to the earlier offset). Chunk maxima are found in parallel; a pick only
+/// makes the chunks under its exclusion zone be scanned again.
+fn best_offsets(keys: &[f32], top: usize, exclusion: usize) -> Vec<usize> {
+    const CHUNK: usize = 4096;
+    let exclusion = exclusion.max(1);
+    let best_in = |c: usize, picked: &[usize]| -> Option<(usize, f32)> {
+        let lo = c * CHUNK;
+        let hi = (lo + CHUNK).min(keys.len());
+        let mut best: Option<(usize, f32)> = None;
+        for (k, &v) in (lo..hi).zip(&keys[lo..hi]) {
+            // NaN fails both comparisons
+            if best.map_or(v.is_finite(), |b| v > b.1)
+                && picked.iter().all(|p| p.abs_diff(k) >= exclusion)
+            {
+                best = Some((k, v));
+            }
+        }
+        best
+    };
+    let n_chunks = keys.len().div_ceil(CHUNK);
+    let mut chunk_best: Vec<Option<(usize, f32)>> = (0..n_chunks)
+        .into_par_iter()
+        .map(|c| best_in(c, &[]))
+        .collect();
+    let mut picked = Vec::with_capacity(top);
+    while picked.len() < top {
+        let next = chunk_best
+            .iter()
+            .flatten()
+            .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)));
+        let Some(&(k, _)) = next else { break };
+        picked.push(k);
+        let first = k.saturating_sub(exclusion - 1) / CHUNK;
+        let last = ((k + exclusion - 1) / CHUNK).min(n_chunks - 1);
+        for c in first..=last {
+            chunk_best[c] = best_in(c, &picked);
+        }
+    }
+    picked
 }
 
 /// CC, MAE, RMSE and overlap at one offset, for checking a claimed time.
@@ -750,5 +753,42 @@ mod tests {
         assert_eq!((t.k, t.u, t.beta), (3, 8.0, 1.5));
         assert!((t.p_value(8.0) - (1.0 - (-3f64).exp())).abs() < 1e-12);
         assert!(t.p_value(8.0 + 1.5 * 15.0) < 1e-5);
+    }
+
+    #[test]
+    fn best_offsets_equal_a_plain_greedy_pick() {
+        // rough keys with plateaus (ties), NaN holes and peaks near chunk borders
+        let mut x = 1u64;
+        let keys: Vec<f32> = (0..50_000)
+            .map(|i| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                if i % 997 < 30 {
+                    f32::NAN
+                } else {
+                    ((x >> 40) % 500) as f32 + if i % 4096 < 3 { 1000.0 } else { 0.0 }
+                }
+            })
+            .collect();
+        for (top, exclusion) in [(1, 60), (5, 60), (12, 5000), (7, 1)] {
+            let mut plain: Vec<usize> = Vec::new();
+            while plain.len() < top {
+                let next = (0..keys.len())
+                    .filter(|&k| keys[k].is_finite())
+                    .filter(|&k| plain.iter().all(|p| p.abs_diff(k) >= exclusion))
+                    .max_by(|&a, &b| keys[a].total_cmp(&keys[b]).then(b.cmp(&a)));
+                match next {
+                    Some(k) => plain.push(k),
+                    None => break,
+                }
+            }
+            assert_eq!(
+                best_offsets(&keys, top, exclusion),
+                plain,
+                "{top} {exclusion}"
+            );
+        }
+        assert!(best_offsets(&[f32::NAN; 10], 3, 2).is_empty());
     }
 }
