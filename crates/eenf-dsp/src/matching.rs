@@ -567,8 +567,8 @@ fn best_offsets(keys: &[f32], top: usize, exclusion: usize) -> Vec<usize> {
         picked.push(k);
         let first = k.saturating_sub(exclusion - 1) / CHUNK;
         let last = ((k + exclusion - 1) / CHUNK).min(n_chunks - 1);
-        for c in first..=last {
-            chunk_best[c] = best_in(c, &picked);
+        for (c, best) in chunk_best.iter_mut().enumerate().take(last + 1).skip(first) {
+            *best = best_in(c, &picked);
         }
     }
     picked
