@@ -62,7 +62,7 @@ fn real_days() -> Option<Vec<Vec<f64>>> {
 /// deviations keep their real spectrum and size but no stretch repeats.
 fn year_from(days: &[Vec<f64>], rng: &mut Rng) -> Vec<f64> {
     let mut year = Vec::with_capacity(365 * DAY);
-    let mut pick = |rng: &mut Rng| {
+    let pick = |rng: &mut Rng| {
         let src = &days[(rng.unit() * days.len() as f64) as usize % days.len()];
         let backwards = rng.unit() < 0.5;
         let rotate = (rng.unit() * DAY as f64) as usize;
