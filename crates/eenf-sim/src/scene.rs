@@ -540,9 +540,16 @@ impl Scene {
         let (cx, cy) = (w / 2.0, h / 2.0);
         let (sin_r, cos_r) = pose.roll.sin_cos();
         let objects = &frame.objects;
+        // column and row followed step by step (a division per pixel costs more than the rest)
+        let (mut col, mut row) = (first % self.width, first / self.width);
         for j in 0..n {
             let p = first + j;
-            let (px, py) = ((p % self.width) as f64 + 0.5, (p / self.width) as f64 + 0.5);
+            let (px, py) = (col as f64 + 0.5, row as f64 + 0.5);
+            col += 1;
+            if col == self.width {
+                col = 0;
+                row += 1;
+            }
             // the world point this pixel sees
             let (x, y) = if self.shake.is_some() {
                 let (rx, ry) = (px - cx, py - cy);
@@ -570,6 +577,10 @@ impl Scene {
                         ..
                     } => {
                         let inside = |u: f64, v: f64| {
+                            // body and head lie within half a width of the centre line
+                            if (u - a).abs() >= width / 2.0 {
+                                return false;
+                            }
                             let yc = yc + b;
                             let body = (u - a).abs() < width / 2.0 && (v - yc).abs() < height / 2.0;
                             let head_r = 0.35 * width;
@@ -600,8 +611,12 @@ impl Scene {
                         ..
                     } => {
                         let (dx, dy) = ((u - centre.0) * w, (v - centre.1) * h);
-                        let rho = dx.hypot(dy) / (radius * h);
-                        if !covered && rho < 1.0 {
+                        let r_px = radius * h;
+                        if covered || dx.abs() >= r_px || dy.abs() >= r_px {
+                            continue;
+                        }
+                        let rho = dx.hypot(dy) / r_px;
+                        if rho < 1.0 {
                             if rho < 0.18 {
                                 covered = true;
                                 refl = 0.15;

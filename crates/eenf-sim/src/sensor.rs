@@ -19,7 +19,7 @@ use crate::scene::{
 /// Time steps simulated together (one output batch).
 const WINDOW_STEPS: usize = 250;
 /// Pixels per chunk (rounded to whole rows): small enough for the cache, many enough per core.
-const CHUNK_PIXELS: usize = 2048;
+const CHUNK_PIXELS: usize = 1024;
 
 /// The pixel circuit.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -276,14 +276,26 @@ pub struct SimStats {
     pub scans: u64,
 }
 
-/// Events of one chunk over one window, in step order: (step in window, pixel, ON, µs offset).
+/// Events of one chunk over one window, in step order, as columns (the pixel already split
+/// into x and y, so that the readout copies whole runs).
 #[derive(Default)]
 struct ChunkEvents {
-    step: Vec<u16>,
-    pixel: Vec<u32>,
+    /// Where each step's events end.
+    step_end: Vec<u32>,
+    x: Vec<u16>,
+    y: Vec<u16>,
     on: Vec<bool>,
+    /// When the threshold was crossed within the step, µs (Prophesee).
     offset_us: Vec<u16>,
     noise: u64,
+}
+
+impl ChunkEvents {
+    /// The range of step `s`'s events.
+    fn step_range(&self, s: usize) -> std::ops::Range<usize> {
+        let start = if s == 0 { 0 } else { self.step_end[s - 1] };
+        start as usize..self.step_end[s] as usize
+    }
 }
 
 /// The state of a block of pixel rows, kept across windows.
@@ -397,6 +409,76 @@ unsafe fn photoreceptor_avx512(s: PixelState, light: &Light, pc: &PixelConsts) {
 #[target_feature(enable = "avx2,fma")]
 unsafe fn photoreceptor_avx2(s: PixelState, light: &Light, pc: &PixelConsts) {
     photoreceptor_generic(s, light, pc)
+}
+
+/// `out[i] = dark + Σ_c (coef_c[i] + u·delta_c[i])·light_c`: the light of a moving scene's
+/// pixels between two motion steps (vectorised like the pixel loop; the slices are arguments
+/// so that the compiler knows they do not overlap).
+fn mix_light(
+    out: &mut [f32],
+    coef: [&[f32]; CHANNELS],
+    delta: [&[f32]; CHANNELS],
+    u: f32,
+    light: [f32; CHANNELS],
+    dark: f32,
+) {
+    #[inline(always)]
+    fn generic(
+        out: &mut [f32],
+        coef: [&[f32]; CHANNELS],
+        delta: [&[f32]; CHANNELS],
+        u: f32,
+        l: [f32; CHANNELS],
+        dark: f32,
+    ) {
+        let n = out.len();
+        let [c0, c1, c2, c3] = coef.map(|c| &c[..n]);
+        let [d0, d1, d2, d3] = delta.map(|d| &d[..n]);
+        for i in 0..n {
+            out[i] = dark
+                + (c0[i] + u * d0[i]) * l[0]
+                + (c1[i] + u * d1[i]) * l[1]
+                + (c2[i] + u * d2[i]) * l[2]
+                + (c3[i] + u * d3[i]) * l[3];
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx512f,avx2,fma")]
+        unsafe fn avx512(
+            out: &mut [f32],
+            coef: [&[f32]; CHANNELS],
+            delta: [&[f32]; CHANNELS],
+            u: f32,
+            l: [f32; CHANNELS],
+            dark: f32,
+        ) {
+            generic(out, coef, delta, u, l, dark)
+        }
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn avx2(
+            out: &mut [f32],
+            coef: [&[f32]; CHANNELS],
+            delta: [&[f32]; CHANNELS],
+            u: f32,
+            l: [f32; CHANNELS],
+            dark: f32,
+        ) {
+            generic(out, coef, delta, u, l, dark)
+        }
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the feature was detected at run time
+            unsafe { avx512(out, coef, delta, u, light, dark) };
+            return;
+        }
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        {
+            // SAFETY: the features were detected at run time
+            unsafe { avx2(out, coef, delta, u, light, dark) };
+            return;
+        }
+    }
+    generic(out, coef, delta, u, light, dark)
 }
 
 #[inline(always)]
@@ -598,6 +680,7 @@ impl Chunk {
             ..ChunkEvents::default()
         };
         let moving = !scene.is_static();
+        let width = scene.dims().0;
         let mut fired: Vec<u32> = Vec::new();
         for (s, step) in steps.iter().enumerate() {
             if moving {
@@ -613,15 +696,14 @@ impl Chunk {
             if moving {
                 // interpolated light of the moving scene, summed in a plain loop first (a
                 // closure this large would not be inlined into the vector loop)
-                let scratch = &mut self.scratch[..n];
-                scratch.fill(pc.dark);
-                for c in 0..CHANNELS {
-                    let l = step.light[c];
-                    let (coef, delta) = (&self.coef[c][..n], &self.delta[c][..n]);
-                    for i in 0..n {
-                        scratch[i] += (coef[i] + u * delta[i]) * l;
-                    }
-                }
+                mix_light(
+                    &mut self.scratch[..n],
+                    std::array::from_fn(|c| &self.coef[c][..n]),
+                    std::array::from_fn(|c| &self.delta[c][..n]),
+                    u,
+                    step.light,
+                    pc.dark,
+                );
             }
             let light = Light {
                 coef: std::array::from_fn(|c| &self.coef[c][..n]),
@@ -644,22 +726,25 @@ impl Chunk {
             photoreceptor_pass(state, &light, pc);
             let scan = first_step + s as u32;
             fired.clear();
-            // skip 8 quiet pixels at a time
-            let cand = &self.candidate[..n];
-            let mut base = 0;
-            for block in cand.chunks(8) {
-                let quiet = match <[u8; 8]>::try_from(block) {
-                    Ok(b) => u64::from_ne_bytes(b) == 0,
-                    Err(_) => block.iter().all(|&c| c == 0),
-                };
-                if !quiet {
-                    for (j, &c) in block.iter().enumerate() {
-                        if c != 0 && scan >= self.ready_at[base + j] {
-                            fired.push((base + j) as u32);
-                        }
+            // eight pixels' flags per word: quiet words are skipped, and in the others each
+            // set byte is found without a branch per pixel
+            let (cand, ready_at) = (&self.candidate[..n], &self.ready_at[..n]);
+            let mut words = cand.chunks_exact(8);
+            for (wi, word) in words.by_ref().enumerate() {
+                let mut bits = u64::from_le_bytes(word.try_into().expect("8 bytes"));
+                while bits != 0 {
+                    let j = wi * 8 + (bits.trailing_zeros() / 8) as usize;
+                    bits &= bits - 1;
+                    if scan >= ready_at[j] {
+                        fired.push(j as u32);
                     }
                 }
-                base += block.len();
+            }
+            let tail = n - words.remainder().len();
+            for (j, &c) in words.remainder().iter().enumerate() {
+                if c != 0 && scan >= ready_at[tail + j] {
+                    fired.push((tail + j) as u32);
+                }
             }
             // this step's noise events join (a pixel fires once per step)
             let noise_from = ni;
@@ -682,8 +767,9 @@ impl Chunk {
                     self.ready_at[i] = scan + pc.refractory_steps;
                 }
                 self.reference[i] += c;
-                out.step.push(s as u16);
-                out.pixel.push((self.first + i) as u32);
+                let p = self.first + i;
+                out.x.push((p % width) as u16);
+                out.y.push((p / width) as u16);
                 out.on.push(on);
                 out.offset_us.push(offset);
             };
@@ -707,6 +793,7 @@ impl Chunk {
                 }
                 emit(p as usize, Some(on), &mut out);
             }
+            out.step_end.push(out.x.len() as u32);
         }
         out
     }
@@ -878,8 +965,8 @@ fn generate(
 
     let mut stats = SimStats::default();
     let mut batch = EventBatch::default();
-    // events waiting in the readout FIFO: (pixel, ON)
-    let mut backlog: std::collections::VecDeque<(u32, bool)> = Default::default();
+    // events waiting in the readout FIFO: (x, y, ON)
+    let mut backlog: std::collections::VecDeque<(u16, u16, bool)> = Default::default();
     let mut step0 = 0usize;
     while step0 < steps_total {
         let n = WINDOW_STEPS.min(steps_total - step0);
@@ -904,20 +991,30 @@ fn generate(
             .par_iter_mut()
             .map(|c| c.run(&scene, &steps, &pc, step0 as u32))
             .collect();
-        // readout: gather each step's events in row-major order
+        // readout: each step's events in row-major order (the chunks are row blocks)
         batch.clear();
-        let mut ptr = vec![0usize; outputs.len()];
-        let mut step_events: Vec<(u16, u32, bool)> = Vec::new();
-        for (s, &t_us) in times.iter().enumerate() {
+        let mut step_events: Vec<(u16, u16, u16, bool)> = Vec::new();
+        for (s, &t_abs) in times.iter().enumerate() {
+            let t_abs = config.start_us + t_abs;
+            let ranges: Vec<std::ops::Range<usize>> =
+                outputs.iter().map(|o| o.step_range(s)).collect();
+            let count: usize = ranges.iter().map(|r| r.len()).sum();
+            if !prophesee && backlog.is_empty() && count <= per_step_cap {
+                // the usual case: the whole scan leaves at once, copied run by run
+                for (o, r) in outputs.iter().zip(&ranges) {
+                    batch.t.extend(std::iter::repeat_n(t_abs, r.len()));
+                    batch.x.extend_from_slice(&o.x[r.clone()]);
+                    batch.y.extend_from_slice(&o.y[r.clone()]);
+                    batch.p.extend_from_slice(&o.on[r.clone()]);
+                }
+                continue;
+            }
             step_events.clear();
-            for (c, out) in outputs.iter().enumerate() {
-                while ptr[c] < out.step.len() && out.step[ptr[c]] as usize == s {
-                    let k = ptr[c];
-                    step_events.push((out.offset_us[k], out.pixel[k], out.on[k]));
-                    ptr[c] += 1;
+            for (o, r) in outputs.iter().zip(&ranges) {
+                for k in r.clone() {
+                    step_events.push((o.offset_us[k], o.x[k], o.y[k], o.on[k]));
                 }
             }
-            let t_abs = config.start_us + t_us;
             if prophesee {
                 step_events.sort_by_key(|e| e.0);
                 if step_events.len() > per_step_cap {
@@ -935,30 +1032,27 @@ fn generate(
                         }
                     });
                 }
-                for &(off, p, on) in &step_events {
-                    let p = p as usize;
+                for &(off, x, y, on) in &step_events {
                     // the crossing happened during the step that ends at t_abs
                     let t = (t_abs - step_us + off as i64).max(config.start_us);
-                    batch.push(t, (p % w) as u16, (p / w) as u16, on);
+                    batch.push(t, x, y, on);
                 }
             } else {
                 // waiting events leave first, then this scan's, up to the scan's capacity
                 let mut budget = per_step_cap;
                 while budget > 0 {
-                    let Some((p, on)) = backlog.pop_front() else {
+                    let Some((x, y, on)) = backlog.pop_front() else {
                         break;
                     };
-                    let p = p as usize;
-                    batch.push(t_abs, (p % w) as u16, (p / w) as u16, on);
+                    batch.push(t_abs, x, y, on);
                     budget -= 1;
                 }
-                for &(_, p, on) in &step_events {
+                for &(_, x, y, on) in &step_events {
                     if budget > 0 {
-                        let p = p as usize;
-                        batch.push(t_abs, (p % w) as u16, (p / w) as u16, on);
+                        batch.push(t_abs, x, y, on);
                         budget -= 1;
                     } else if backlog.len() < fifo_cap {
-                        backlog.push_back((p, on));
+                        backlog.push_back((x, y, on));
                         stats.delayed_events += 1;
                     } else {
                         stats.dropped_events += 1;
