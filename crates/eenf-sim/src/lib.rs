@@ -24,11 +24,13 @@
 //! assert!(events > 1000);
 //! ```
 
+mod camera;
 mod lamp;
 mod mains;
 mod scene;
 mod sensor;
 
+pub use camera::{render_video, CameraConfig, VideoStats};
 pub use lamp::{Lamp, LampBank, LampKind};
 pub use mains::{MainsError, MainsPhase, SyntheticEnf};
 pub use scene::{MovingObject, Region, Scene, SceneConfig, SceneKind, Shake, CHANNELS, MAX_LAMPS};

@@ -38,6 +38,8 @@ enum Command {
     Refdb(commands::refdb::Cmd),
     /// Find when a trace was recorded by matching it against long references.
     Match(commands::matching::Args),
+    /// Extract the ENF trace from a conventional video's rolling-shutter flicker (V-ENF).
+    Video(commands::video::Args),
     /// Simulate an event recording of a flickering scene, with its ground-truth ENF.
     Simulate(commands::simulate::Args),
     /// Simulate a whole EV-ENFD-like dataset: static, dynamic and extreme recordings with
@@ -58,6 +60,7 @@ fn main() -> ExitCode {
         Command::Compare(a) => commands::compare::run(a, progress),
         Command::Refdb(c) => commands::refdb::run(c, progress),
         Command::Match(a) => commands::matching::run(a, progress),
+        Command::Video(a) => commands::video::run(a, progress),
         Command::Simulate(a) => commands::simulate::run(a, progress).map(|_| ()),
         Command::SimulateDataset(a) => commands::simulate_dataset::run(a, progress),
         Command::Demo(a) => commands::demo::run(a, progress),

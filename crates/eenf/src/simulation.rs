@@ -357,3 +357,65 @@ pub fn write_recording(
         seconds,
     })
 }
+
+/// Parses `lr,hr` into camera presets, scaled by `scale` (0 < scale ≤ 1).
+pub fn parse_cameras(list: &str, scale: f64) -> anyhow::Result<Vec<eenf_sim::CameraConfig>> {
+    if !(scale > 0.0 && scale <= 1.0) {
+        anyhow::bail!("--video-scale must lie in (0, 1], not {scale}");
+    }
+    list.split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|name| {
+            eenf_sim::CameraConfig::named(name.trim())
+                .map(|c| c.scaled(scale))
+                .ok_or_else(|| anyhow::anyhow!("--video {name:?}: expected lr or hr"))
+        })
+        .collect()
+}
+
+/// Renders the same scene and lighting as `config` through `camera` into
+/// `<stem>_<camera>.y4m` beside `output` (and `.mp4` too when `mp4` and ffmpeg is there).
+/// Returns the files written.
+pub fn write_video(
+    config: &SimConfig,
+    camera: &eenf_sim::CameraConfig,
+    mains: &MainsPhase,
+    output: &Path,
+    mp4: bool,
+    progress: &Progress,
+) -> anyhow::Result<Vec<PathBuf>> {
+    camera
+        .check()
+        .map_err(|e| anyhow::anyhow!("camera {}: {e}", camera.name))?;
+    let stem = output.file_stem().unwrap_or_default().to_string_lossy();
+    let y4m = output.with_file_name(format!("{stem}_{}.y4m", camera.name));
+    let frames = (config.duration_s * camera.fps).floor() as u64;
+    let bar = progress.steps(frames, &format!("{} frames", camera.name));
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    write_atomic(&y4m, |out| {
+        let mut writer = eenf_video::Y4mWriter::new(out, w, h, camera.fps)?;
+        eenf_sim::render_video(config, camera, mains, |frame| {
+            bar.inc(1);
+            writer.write_frame(frame)
+        })?;
+        Ok(())
+    })?;
+    bar.finish_and_clear();
+    let mut written = vec![y4m.clone()];
+    if mp4 {
+        let mp4_path = y4m.with_extension("mp4");
+        let tool = std::env::var("EENF_FFMPEG").unwrap_or_else(|_| "ffmpeg".into());
+        let status = std::process::Command::new(&tool)
+            .args(["-v", "error", "-y", "-i"])
+            .arg(&y4m)
+            .args(["-c:v", "libx264", "-pix_fmt", "yuv420p", "-crf", "18"])
+            .arg(&mp4_path)
+            .status();
+        match status {
+            Ok(s) if s.success() => written.push(mp4_path),
+            Ok(s) => anyhow::bail!("{}: ffmpeg failed ({s})", mp4_path.display()),
+            Err(e) => eprintln!("note: no MP4 ({tool}: {e}); the Y4M is written"),
+        }
+    }
+    Ok(written)
+}

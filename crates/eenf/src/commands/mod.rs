@@ -11,3 +11,4 @@ pub mod refdb;
 pub mod reference;
 pub mod simulate;
 pub mod simulate_dataset;
+pub mod video;

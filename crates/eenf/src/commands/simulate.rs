@@ -75,6 +75,17 @@ pub struct Args {
     /// Output format: aedat4, evt2, evt3, dat, text (default: from the extension).
     #[arg(long)]
     pub format: Option<String>,
+    /// Also render the same scene through conventional cameras, comma-separated: `lr`
+    /// (webcam, 640x480, 30 fps) and/or `hr` (phone, 1920x1080, ISO 1600, 1/200 s), written
+    /// as NAME_lr.y4m / NAME_hr.y4m beside the recording.
+    #[arg(long)]
+    pub video: Option<String>,
+    /// Scale the videos' frames by this factor (0..1], for speed.
+    #[arg(long, default_value_t = 1.0)]
+    pub video_scale: f64,
+    /// Also encode each video as MP4 (H.264) with ffmpeg.
+    #[arg(long)]
+    pub mp4: bool,
 }
 
 impl Default for Args {
@@ -232,6 +243,10 @@ pub fn run(a: Args, progress: Progress) -> Result<Simulated> {
         "local_start": start,
         "utc_offset_s": tz,
     });
+    let cameras = match &a.video {
+        Some(list) => eenf_cli::simulation::parse_cameras(list, a.video_scale)?,
+        None => Vec::new(),
+    };
     let sim = write_recording(&config, &mains, &a.output, format, extra, &progress)?;
     eprintln!(
         "simulated {:.0} s at {}x{}: {} events ({:.1} M events/s generated) in {:.1} s",
@@ -250,6 +265,13 @@ pub fn run(a: Args, progress: Progress) -> Result<Simulated> {
     }
     eprintln!("recording  {}", a.output.display());
     eprintln!("truth      {}", sim.truth.display());
+    for camera in &cameras {
+        for p in
+            eenf_cli::simulation::write_video(&config, camera, &mains, &a.output, a.mp4, &progress)?
+        {
+            eprintln!("video      {}", p.display());
+        }
+    }
     if let Some(dir) = &a.reference_dir {
         let written = timeline.write_references(dir, start, start + a.duration, a.seed)?;
         for p in written {
