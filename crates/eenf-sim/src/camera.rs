@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::lamp::LampBank;
 use crate::mains::MainsPhase;
-use crate::scene::{Scene, CHANNELS, MAX_LAMPS};
+use crate::scene::{CHANNELS, MAX_LAMPS};
 use crate::sensor::SimConfig;
 
 /// How the camera exposes and reads out its rows, and how it turns light into 8-bit values.
@@ -233,22 +233,8 @@ pub fn render_video<E>(
     mut sink: impl FnMut(&[u8]) -> Result<(), E>,
 ) -> Result<VideoStats, E> {
     let (w, h) = (camera.width as usize, camera.height as usize);
-    let shares: Vec<f64> = config
-        .lamps
-        .iter()
-        .take(MAX_LAMPS)
-        .map(|l| l.share)
-        .collect();
-    // the same scene (its texture and lamp pools are laid out in fractions of the view)
-    let scene = Scene::new(
-        &config.scene,
-        w,
-        h,
-        &shares,
-        config.ambient,
-        config.illumination,
-        config.seed,
-    );
+    // the same scene as the event sensor's, laid out for this frame
+    let (scene, shares) = config.scene_at(w, h);
     let bank = LampBank::new(&config.lamps[..shares.len()], mains);
     let period = 1.0 / camera.fps;
     // row i starts i·T_row after row 0; the rows after the last are the idle gap

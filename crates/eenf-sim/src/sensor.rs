@@ -232,6 +232,23 @@ impl SimConfig {
         self
     }
 
+    /// The configured scene laid out for a `w` × `h` view (its texture and lamp pools are
+    /// placed in fractions of the view, so any resolution sees the same room), with the shares
+    /// of the lamps it uses.
+    pub fn scene_at(&self, w: usize, h: usize) -> (Scene, Vec<f64>) {
+        let shares: Vec<f64> = self.lamps.iter().take(MAX_LAMPS).map(|l| l.share).collect();
+        let scene = Scene::new(
+            &self.scene,
+            w,
+            h,
+            &shares,
+            self.ambient,
+            self.illumination,
+            self.seed,
+        );
+        (scene, shares)
+    }
+
     /// Why this configuration cannot be simulated, if it cannot.
     pub fn check(&self) -> Result<(), String> {
         if self.width == 0 || self.height == 0 {
@@ -837,21 +854,7 @@ fn generate(
     recycled: std::sync::mpsc::Receiver<EventBatch>,
 ) -> SimStats {
     let (w, h) = (config.width as usize, config.height as usize);
-    let shares: Vec<f64> = config
-        .lamps
-        .iter()
-        .take(MAX_LAMPS)
-        .map(|l| l.share)
-        .collect();
-    let scene = Scene::new(
-        &config.scene,
-        w,
-        h,
-        &shares,
-        config.ambient,
-        config.illumination,
-        config.seed,
-    );
+    let (scene, shares) = config.scene_at(w, h);
     let mut rng = rand::rngs::StdRng::seed_from_u64(config.seed);
     let px = &config.pixel;
     let thr = Normal::new(px.threshold, px.threshold_spread.max(1e-9)).unwrap();
