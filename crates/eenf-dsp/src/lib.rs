@@ -24,6 +24,7 @@ pub mod matching;
 pub mod metrics;
 pub mod postprocess;
 pub mod sampling;
+pub mod spectrogram;
 pub mod tracker;
 
 pub use butter::{butter_bandpass, sos_to_ba, Section};
@@ -35,4 +36,5 @@ pub use filtfilt::sosfiltfilt;
 pub use metrics::{agreement, Agreement};
 pub use postprocess::{median_correct, select_harmonics, HarmonicSelection};
 pub use sampling::{PolaritySequence, SamplingError, SamplingMethod, TemporalSampler};
+pub use spectrogram::{spectrogram, Spectrogram};
 pub use tracker::{PeakMethod, StftTracker};

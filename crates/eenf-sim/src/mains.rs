@@ -120,6 +120,28 @@ fn spline_at(v: &[f64], x: f64) -> f64 {
         * (p2 - p0 + u * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + u * (3.0 * (p1 - p2) + p3 - p0)))
 }
 
+/// The phase (rad, modulo 2π) that the frequency series `freq_hz` (values `step_s` apart,
+/// interpolated as [`MainsPhase::from_frequency`] does) accumulates from its start to `t_s`.
+/// The spline is cubic between knots, so Simpson's rule per knot interval is exact; pieces of
+/// one series cut at different starts then join with a continuous phase.
+pub fn phase_from_start(freq_hz: &[f64], step_s: f64, t_s: f64) -> f64 {
+    let x_end = (t_s / step_s).max(0.0);
+    let simpson = |a: f64, b: f64| {
+        (b - a) / 6.0
+            * (spline_at(freq_hz, a)
+                + 4.0 * spline_at(freq_hz, 0.5 * (a + b))
+                + spline_at(freq_hz, b))
+    };
+    let whole = x_end.floor() as usize;
+    let mut cycles = 0.0f64;
+    for i in 0..whole {
+        // whole cycles do not matter: keep the fraction so precision holds over days
+        cycles = (cycles + simpson(i as f64, (i + 1) as f64) * step_s).fract();
+    }
+    cycles += simpson(whole as f64, x_end) * step_s;
+    2.0 * PI * cycles.fract()
+}
+
 impl MainsPhase {
     /// A wandering ENF from the synthetic process, linearly interpolated between seconds and
     /// integrated into phase.
@@ -290,6 +312,28 @@ impl MainsPhase {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pieces_of_one_series_join_with_a_continuous_phase() {
+        let freq: Vec<f64> = (0..400)
+            .map(|i| 50.0 + 0.02 * (i as f64 * 0.05).sin() + 0.003 * (i as f64 * 0.7).cos())
+            .collect();
+        let (step, cut) = (2.0, 333.3);
+        let first = MainsPhase::from_frequency(50.0, &freq, step, 0.0, cut + 1.0, 0.0);
+        let second = MainsPhase::from_frequency(
+            50.0,
+            &freq,
+            step,
+            cut,
+            10.0,
+            phase_from_start(&freq, step, cut),
+        );
+        let wrap = |d: f64| (d + PI).rem_euclid(2.0 * PI) - PI;
+        for dt in [0.0, 0.25, 0.5] {
+            let d = wrap(first.phase_at(cut + dt) - second.phase_at(dt));
+            assert!(d.abs() < 1e-6, "phase step {d} rad at {dt} s after the cut");
+        }
+    }
 
     #[test]
     fn synthetic_enf_has_grid_like_statistics() {

@@ -28,7 +28,10 @@ fn render(camera: &CameraConfig, seconds: f64, seed: u64) -> (tempfile::TempPath
 
 #[test]
 fn zero_padded_rows_recover_the_enf_of_a_static_scene() {
-    let camera = CameraConfig::lr().scaled(0.25);
+    // a webcam with its anti-flicker setting off and a 25 ms exposure (2.5 flicker periods)
+    let mut camera = CameraConfig::lr().scaled(0.25);
+    camera.anti_flicker = false;
+    camera.exposure_s = 0.025;
     let seconds = 60.0;
     let (path, mains) = render(&camera, seconds, 3);
     let mut source = FrameSource::open(&path).unwrap();
@@ -60,6 +63,33 @@ fn zero_padded_rows_recover_the_enf_of_a_static_scene() {
         b.cc
     );
     assert!(b.cc >= 0.95, "CC {}", b.cc);
+}
+
+/// RMS of the row means after the paper's scene removal.
+fn ripple_rms(path: &std::path::Path) -> f64 {
+    let mut source = FrameSource::open(path).unwrap();
+    let rows = RowMeans::read(&mut source, |_| {})
+        .unwrap()
+        .without_scene(eenf_video::SceneRemoval::Paper);
+    (rows.values.iter().map(|v| v * v).sum::<f64>() / rows.values.len() as f64).sqrt()
+}
+
+#[test]
+fn anti_flicker_exposure_nulls_the_ripple_as_the_box_filter_predicts() {
+    // the same webcam with a free 25 ms exposure and with its anti-flicker setting (30 ms,
+    // three flicker periods): a box filter of length T passes the 2f line with gain
+    // |sinc(2f·T)|, 0.127 at 25 ms and ~0 at 30 ms, so only the noise is left
+    let mut free = CameraConfig::lr().scaled(0.25);
+    free.anti_flicker = false;
+    free.exposure_s = 0.025;
+    let locked = CameraConfig::lr().scaled(0.25);
+    assert!((locked.exposure_on(50.0) - 0.030).abs() < 1e-12);
+    let (a, _) = render(&free, 8.0, 7);
+    let (b, _) = render(&locked, 8.0, 7);
+    let (ra, rb) = (ripple_rms(&a), ripple_rms(&b));
+    // what the locked camera keeps is mostly its noise (shot, read, 8-bit steps)
+    println!("ripple rms: free 25 ms {ra:.4}, anti-flicker 30 ms {rb:.4} (of 255)");
+    assert!(ra > 5.0 * rb, "anti-flicker left {rb} of {ra}");
 }
 
 #[test]

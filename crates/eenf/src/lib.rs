@@ -4,9 +4,12 @@
 //! call directly: [`pipeline::extract_file`] (event file → ENF trace),
 //! [`pipeline::reference_file`] (mains WAV → reference trace),
 //! [`pipeline::reference_for_recording`] (a dataset's hourly references → the reference of one
-//! recording) and [`pipeline::align`].
+//! recording), [`pipeline::align`], [`evaluate::compare`] (a trace against its reference) and
+//! [`bench`] (a whole dataset, every method).
 
+pub mod bench;
 pub mod dataset;
+pub mod evaluate;
 pub mod output;
 pub mod pipeline;
 pub mod plot;

@@ -45,6 +45,9 @@ enum Command {
     /// Simulate a whole EV-ENFD-like dataset: static, dynamic and extreme recordings with
     /// hourly mains references.
     SimulateDataset(commands::simulate_dataset::Args),
+    /// Evaluate methods over a dataset (EV-ENFD-like folder or manifest): the paper's Table 2,
+    /// per-recording scores, reports, plots and ablations.
+    Bench(commands::bench::Args),
     /// Simulate 60 s, extract the ENF, compare it with the truth: the whole method in one go.
     Demo(commands::demo::Args),
 }
@@ -63,6 +66,7 @@ fn main() -> ExitCode {
         Command::Video(a) => commands::video::run(a, progress),
         Command::Simulate(a) => commands::simulate::run(a, progress).map(|_| ()),
         Command::SimulateDataset(a) => commands::simulate_dataset::run(a, progress),
+        Command::Bench(a) => commands::bench::run(a, progress),
         Command::Demo(a) => commands::demo::run(a, progress),
     };
     match result {

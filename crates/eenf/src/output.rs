@@ -191,6 +191,79 @@ pub fn read_series_csv(path: &Path, step: Option<f64>) -> Result<(f64, Vec<f64>)
     Ok((step, vals))
 }
 
+/// The JSON form of an extraction.
+pub fn extraction_json(x: &crate::pipeline::Extraction) -> serde_json::Value {
+    let t = times(x.trace.enf_hz.len(), x.trace.step_s);
+    let seg = x.trace.segment_len as f64 * x.trace.step_s;
+    let selected: Vec<_> = x
+        .trace
+        .selected
+        .iter()
+        .enumerate()
+        .map(|(i, m)| serde_json::json!({"start_s": i as f64 * seg, "harmonic": m}))
+        .collect();
+    let nan_to_null =
+        |v: &[f64]| -> Vec<Option<f64>> { v.iter().map(|f| f.is_finite().then_some(*f)).collect() };
+    let harmonics: Vec<_> = x
+        .trace
+        .harmonics
+        .iter()
+        .map(|h| {
+            serde_json::json!({"harmonic": h.harmonic, "center_hz": h.center_hz,
+                "enf_hz": nan_to_null(&h.enf_hz)})
+        })
+        .collect();
+    serde_json::json!({
+        "file": x.path,
+        "format": x.info.format,
+        "start_t_us": x.t0_us,
+        "start_utc": utc_string(x.t0_us),
+        "events": x.events,
+        "duration_s": x.duration_s,
+        "nominal_hz": x.params.nominal_hz,
+        "sampling": x.sampling.name(),
+        "dt_us": x.dt_us,
+        "params": x.params,
+        "step_s": x.trace.step_s,
+        "time_s": t,
+        "enf_hz": nan_to_null(&x.trace.enf_hz),
+        "harmonics": harmonics,
+        "selected": selected,
+    })
+}
+
+/// The JSON form of a video trace (readable by `compare`).
+pub fn video_json(
+    path: &Path,
+    t: &eenf_video::VideoTrace,
+    opts: &eenf_video::VideoOptions,
+) -> serde_json::Value {
+    let enf: Vec<Option<f64>> = t
+        .enf_hz
+        .iter()
+        .map(|f| f.is_finite().then_some(*f))
+        .collect();
+    serde_json::json!({
+        "file": path,
+        "method": "v-enf",
+        "width": t.info.width,
+        "height": t.info.height,
+        "fps": t.info.fps,
+        "frames": t.frames,
+        "nominal_hz": t.nominal_hz,
+        "sampling": opts.sampling,
+        "scene_removal": opts.scene_removal,
+        "virtual_rows": t.virtual_rows,
+        "fs_hz": t.fs,
+        "line_hz": t.line_hz,
+        "prominence": t.prominence,
+        "params": opts.params,
+        "step_s": t.step_s,
+        "time_s": times(t.enf_hz.len(), t.step_s),
+        "enf_hz": enf,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -113,6 +113,19 @@ pub fn sample_file(
 /// E-ENF from an event file.
 pub fn extract_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> Result<Extraction> {
     let (info, events, seq) = sample_file(path, opts.sampling, opts.dt_us, progress)?;
+    extract_sequence(path, info, events, &seq, opts, progress)
+}
+
+/// E-ENF from a polarity sequence already sampled from `path` (with `opts.sampling` and
+/// `opts.dt_us`).
+pub fn extract_sequence(
+    path: &Path,
+    info: StreamInfo,
+    events: u64,
+    seq: &PolaritySequence,
+    opts: &ExtractOptions,
+    progress: &Progress,
+) -> Result<Extraction> {
     let x: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
     let fs = seq.fs();
     let mut params = opts.params.clone();
@@ -136,7 +149,7 @@ pub fn extract_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> 
         }
     };
     let spin = progress.spinner("tracking the ENF");
-    let trace = extract_enf(&seq, &params).map_err(err)?;
+    let trace = extract_enf(seq, &params).map_err(err)?;
     spin.finish_and_clear();
     Ok(Extraction {
         path: path.to_path_buf(),

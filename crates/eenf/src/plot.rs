@@ -108,40 +108,74 @@ fn legend<'a, DB: DrawingBackend + 'a>(c: &mut Panel<'a, DB>) -> Result<()> {
         .map_err(e)
 }
 
+/// One estimate against the reference (aligned), for [`plot_methods`].
+pub struct Series<'a> {
+    /// Legend label.
+    pub label: String,
+    /// Times, s from the recording start.
+    pub time_s: &'a [f64],
+    /// Estimate, Hz.
+    pub estimate: &'a [f64],
+    /// Reference at those times, Hz.
+    pub reference: &'a [f64],
+    /// Colour of this series in the palette (the same method keeps its colour across figures).
+    pub colour: usize,
+}
+
 fn comparison<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
-    t: &[f64],
-    est: &[f64],
-    reference: &[f64],
+    series: &[Series],
 ) -> Result<()> {
     root.fill(&WHITE).map_err(e)?;
     let root = root.titled(title, ("sans-serif", 22)).map_err(e)?;
     let (upper, lower) = root.split_vertically(SIZE.1 as i32 * 62 / 100);
-    let x = range(t.iter().copied());
-    let y = range(est.iter().chain(reference).copied());
+    let x = range(series.iter().flat_map(|s| s.time_s.iter().copied()));
+    let y = range(
+        series
+            .iter()
+            .flat_map(|s| s.estimate.iter().chain(s.reference).copied()),
+    );
     let mut c = enf_panel(&upper, x, y)?;
-    c.draw_series(LineSeries::new(
-        t.iter().zip(reference).map(|(a, b)| (*a, *b)),
-        BLACK.stroke_width(2),
-    ))
-    .map_err(e)?
-    .label("reference")
-    .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-    c.draw_series(LineSeries::new(
-        t.iter().zip(est).map(|(a, b)| (*a, *b)),
-        RED.stroke_width(2),
-    ))
-    .map_err(e)?
-    .label("estimate")
-    .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
+    // the reference: the longest of the series' aligned references (they are the same signal)
+    if let Some(r) = series.iter().max_by_key(|s| s.time_s.len()) {
+        c.draw_series(LineSeries::new(
+            r.time_s.iter().zip(r.reference).map(|(a, b)| (*a, *b)),
+            BLACK.stroke_width(2),
+        ))
+        .map_err(e)?
+        .label("reference")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+    }
+    let colour = |s: &Series| {
+        if series.len() == 1 {
+            RED
+        } else {
+            PALETTE[s.colour % PALETTE.len()]
+        }
+    };
+    for s in series {
+        let col = colour(s);
+        c.draw_series(LineSeries::new(
+            s.time_s.iter().zip(s.estimate).map(|(a, b)| (*a, *b)),
+            col.stroke_width(2),
+        ))
+        .map_err(e)?
+        .label(s.label.clone())
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col.stroke_width(2)));
+    }
     legend(&mut c)?;
-    let err: Vec<f64> = est
+    let errors: Vec<Vec<f64>> = series
         .iter()
-        .zip(reference)
-        .map(|(a, b)| (a - b) * 1e3)
+        .map(|s| {
+            s.estimate
+                .iter()
+                .zip(s.reference)
+                .map(|(a, b)| (a - b) * 1e3)
+                .collect()
+        })
         .collect();
-    let ey = range(err.iter().copied().chain([0.0]));
+    let ey = range(errors.iter().flatten().copied().chain([0.0]));
     let mut c = ChartBuilder::on(&lower)
         .margin(12)
         .x_label_area_size(40)
@@ -156,11 +190,14 @@ fn comparison<DB: DrawingBackend>(
         .map_err(e)?;
     c.draw_series(LineSeries::new([(x.0, 0.0), (x.1, 0.0)], BLACK.mix(0.4)))
         .map_err(e)?;
-    c.draw_series(LineSeries::new(
-        t.iter().zip(&err).map(|(a, b)| (*a, *b)),
-        BLUE.stroke_width(2),
-    ))
-    .map_err(e)?;
+    for (s, err) in series.iter().zip(&errors) {
+        let col = if series.len() == 1 { BLUE } else { colour(s) };
+        c.draw_series(LineSeries::new(
+            s.time_s.iter().zip(err).map(|(a, b)| (*a, *b)),
+            col.stroke_width(2),
+        ))
+        .map_err(e)?;
+    }
     Ok(())
 }
 
@@ -172,10 +209,289 @@ pub fn plot_comparison(
     est: &[f64],
     reference: &[f64],
 ) -> Result<()> {
+    plot_methods(
+        path,
+        title,
+        &[Series {
+            label: "estimate".into(),
+            time_s: t,
+            estimate: est,
+            reference,
+            colour: 0,
+        }],
+    )
+}
+
+/// Several estimates (one per method) against the reference, with their errors (mHz) below.
+pub fn plot_methods(path: &Path, title: &str, series: &[Series]) -> Result<()> {
     render(
         path,
-        |root| comparison(root, title, t, est, reference),
-        |root| comparison(root, title, t, est, reference),
+        |root| comparison(root, title, series),
+        |root| comparison(root, title, series),
+    )
+}
+
+/// A perceptually ordered colour map (dark blue → yellow) for 0..=1.
+fn heat(v: f64) -> RGBColor {
+    const STOPS: [(f64, [f64; 3]); 5] = [
+        (0.0, [68.0, 1.0, 84.0]),
+        (0.25, [59.0, 82.0, 139.0]),
+        (0.5, [33.0, 145.0, 140.0]),
+        (0.75, [94.0, 201.0, 98.0]),
+        (1.0, [253.0, 231.0, 37.0]),
+    ];
+    let v = v.clamp(0.0, 1.0);
+    let k = STOPS.iter().rposition(|s| s.0 <= v).unwrap_or(0).min(3);
+    let (a, b) = (STOPS[k], STOPS[k + 1]);
+    let w = (v - a.0) / (b.0 - a.0);
+    let c = |i: usize| (a.1[i] + (b.1[i] - a.1[i]) * w).round() as u8;
+    RGBColor(c(0), c(1), c(2))
+}
+
+fn spectrogram_chart<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    s: &eenf_dsp::Spectrogram,
+    line: Option<(&[f64], &[f64])>,
+    floor_db: f64,
+) -> Result<()> {
+    root.fill(&WHITE).map_err(e)?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(e)?;
+    let (nt, nf) = (s.time_s.len(), s.freq_hz.len());
+    if nt == 0 || nf == 0 {
+        bail!("empty spectrogram");
+    }
+    let dt = if nt > 1 {
+        s.time_s[1] - s.time_s[0]
+    } else {
+        1.0
+    };
+    let df = if nf > 1 {
+        s.freq_hz[1] - s.freq_hz[0]
+    } else {
+        0.01
+    };
+    let x = (s.time_s[0] - dt / 2.0, s.time_s[nt - 1] + dt / 2.0);
+    let y = (s.freq_hz[0] - df / 2.0, s.freq_hz[nf - 1] + df / 2.0);
+    let (plot_area, bar_area) = root.split_horizontally(SIZE.0 as i32 - 120);
+    let mut c = ChartBuilder::on(&plot_area)
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x.0..x.1, y.0..y.1)
+        .map_err(e)?;
+    c.configure_mesh()
+        .disable_mesh()
+        .x_desc("time from recording start (s)")
+        .y_desc("frequency (Hz)")
+        .y_label_formatter(&|v| format!("{v:.2}"))
+        .draw()
+        .map_err(e)?;
+    c.draw_series((0..nt).flat_map(|i| {
+        (0..nf).map(move |k| {
+            let v = (s.power_db[i * nf + k] as f64 - floor_db) / -floor_db;
+            Rectangle::new(
+                [
+                    (s.time_s[i] - dt / 2.0, s.freq_hz[k] - df / 2.0),
+                    (s.time_s[i] + dt / 2.0, s.freq_hz[k] + df / 2.0),
+                ],
+                heat(v).filled(),
+            )
+        })
+    }))
+    .map_err(e)?;
+    if let Some((t, f)) = line {
+        c.draw_series(LineSeries::new(
+            t.iter()
+                .zip(f)
+                .filter(|(_, v)| v.is_finite())
+                .map(|(a, b)| (*a, *b)),
+            WHITE.stroke_width(2),
+        ))
+        .map_err(e)?
+        .label("2 x reference ENF")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], WHITE.stroke_width(2)));
+        c.configure_series_labels()
+            .background_style(BLACK.mix(0.5))
+            .label_font(("sans-serif", 15).into_font().color(&WHITE))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(e)?;
+    }
+    // colour bar
+    let mut b = ChartBuilder::on(&bar_area)
+        .margin(12)
+        .margin_left(4)
+        .x_label_area_size(40)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..1.0, floor_db..0.0)
+        .map_err(e)?;
+    b.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .y_desc("power (dB)")
+        .draw()
+        .map_err(e)?;
+    let steps = 64;
+    b.draw_series((0..steps).map(|k| {
+        let lo = floor_db * (1.0 - k as f64 / steps as f64);
+        let hi = floor_db * (1.0 - (k + 1) as f64 / steps as f64);
+        Rectangle::new(
+            [(0.0, lo), (1.0, hi)],
+            heat(k as f64 / steps as f64).filled(),
+        )
+    }))
+    .map_err(e)?;
+    Ok(())
+}
+
+/// A spectrogram (dB, clipped at `floor_db` below its peak) with an optional line drawn over
+/// it (times, frequencies).
+pub fn plot_spectrogram(
+    path: &Path,
+    title: &str,
+    s: &eenf_dsp::Spectrogram,
+    line: Option<(&[f64], &[f64])>,
+    floor_db: f64,
+) -> Result<()> {
+    render(
+        path,
+        |root| spectrogram_chart(root, title, s, line, floor_db),
+        |root| spectrogram_chart(root, title, s, line, floor_db),
+    )
+}
+
+/// One bar group of [`plot_summary`]: a method's mean per class, and the paper's value.
+pub struct SummaryBar {
+    /// Class.
+    pub class: String,
+    /// Method label.
+    pub method: String,
+    /// Index of the method (colour).
+    pub method_index: usize,
+    /// eenf's mean CC (NaN when nothing was scored).
+    pub cc: f64,
+    /// eenf's mean MAE, mHz.
+    pub mae_mhz: f64,
+    /// The paper's (CC, MAE mHz).
+    pub paper: Option<(f64, f64)>,
+}
+
+fn summary_chart<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    classes: &[String],
+    methods: &[String],
+    bars: &[SummaryBar],
+) -> Result<()> {
+    root.fill(&WHITE).map_err(e)?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(e)?;
+    let (left, right) = root.split_horizontally(SIZE.0 as i32 / 2);
+    let nm = methods.len().max(1) as f64;
+    let slot = |b: &SummaryBar| {
+        let ci = classes.iter().position(|c| *c == b.class).unwrap_or(0) as f64;
+        let x0 = ci + 0.1 + 0.8 * b.method_index as f64 / nm;
+        (x0, x0 + 0.8 / nm)
+    };
+    let max_mae = bars
+        .iter()
+        .flat_map(|b| [b.mae_mhz, b.paper.map_or(0.0, |p| p.1)])
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max)
+        * 1.15;
+    for (panel, is_cc) in [(&left, true), (&right, false)] {
+        let ytop = if is_cc { 1.0 } else { max_mae.max(0.1) };
+        let ybot = if is_cc {
+            bars.iter()
+                .flat_map(|b| [b.cc, b.paper.map_or(0.0, |p| p.0)])
+                .filter(|v| v.is_finite())
+                .fold(0.0, f64::min)
+        } else {
+            0.0
+        };
+        let mut c = ChartBuilder::on(panel)
+            .margin(14)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .caption(
+                if is_cc {
+                    "mean CC (higher is better)"
+                } else {
+                    "mean MAE, mHz (lower is better)"
+                },
+                ("sans-serif", 18),
+            )
+            .build_cartesian_2d(0.0..classes.len() as f64, ybot..ytop)
+            .map_err(e)?;
+        let names = classes.to_vec();
+        c.configure_mesh()
+            .disable_x_mesh()
+            .x_labels(classes.len() * 2 + 1)
+            .x_label_formatter(&|v| {
+                let k = v.floor() as usize;
+                if (v - k as f64 - 0.5).abs() < 1e-6 {
+                    names.get(k).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .x_desc("scene class")
+            .y_desc(if is_cc { "CC" } else { "MAE (mHz)" })
+            .draw()
+            .map_err(e)?;
+        for (k, m) in methods.iter().enumerate() {
+            let col = PALETTE[k % PALETTE.len()];
+            let mine: Vec<&SummaryBar> = bars.iter().filter(|b| b.method_index == k).collect();
+            c.draw_series(mine.iter().filter_map(|b| {
+                let v = if is_cc { b.cc } else { b.mae_mhz };
+                v.is_finite().then(|| {
+                    let (x0, x1) = slot(b);
+                    Rectangle::new([(x0, 0.0), (x1, v)], col.filled())
+                })
+            }))
+            .map_err(e)?
+            .label(format!("{m} (eenf)"))
+            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 14, y + 6)], col.filled()));
+        }
+        // the paper's values: black ticks across each bar
+        c.draw_series(bars.iter().filter_map(|b| {
+            b.paper.map(|p| {
+                let v = if is_cc { p.0 } else { p.1 };
+                let (x0, x1) = slot(b);
+                PathElement::new([(x0, v), (x1, v)], BLACK.stroke_width(3))
+            })
+        }))
+        .map_err(e)?
+        .label("paper (real EV-ENFD)")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 14, y)], BLACK.stroke_width(3)));
+        c.configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(if is_cc {
+                SeriesLabelPosition::LowerLeft
+            } else {
+                SeriesLabelPosition::UpperLeft
+            })
+            .draw()
+            .map_err(e)?;
+    }
+    Ok(())
+}
+
+/// Mean CC and MAE per class and method as grouped bars, with the paper's values as ticks.
+pub fn plot_summary(
+    path: &Path,
+    title: &str,
+    classes: &[String],
+    methods: &[String],
+    bars: &[SummaryBar],
+) -> Result<()> {
+    render(
+        path,
+        |root| summary_chart(root, title, classes, methods, bars),
+        |root| summary_chart(root, title, classes, methods, bars),
     )
 }
 

@@ -159,14 +159,15 @@ impl EnfTimeline {
                         start - from
                     );
                 }
-                // the phase runs on from the series' start, so pieces cut from one series fit
+                // the phase runs on from the series' start, so pieces cut from one series
+                // (a recording, the hourly references) join without a phase step
                 Ok(MainsPhase::from_frequency(
                     *nominal_hz,
                     values,
                     *step_s,
                     start - t0,
                     duration_s,
-                    0.0,
+                    eenf_sim::phase_from_start(values, *step_s, start - t0),
                 ))
             }
             EnfTimeline::Mains { nominal_hz, files } => {
@@ -322,6 +323,9 @@ pub fn write_recording(
         (config.duration_s * 1e6 / step_us as f64) as u64,
         "simulating",
     );
+    if let Some(parent) = output.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).with_context(|| format!("{}", parent.display()))?;
+    }
     let mut writer = create(output, format, config.width, config.height)?;
     let stats = simulate(config, mains, |b| {
         bar.inc(250);
@@ -358,16 +362,25 @@ pub fn write_recording(
     })
 }
 
-/// Parses `lr,hr` into camera presets, scaled by `scale` (0 < scale ≤ 1).
+/// Parses `lr,hr` into camera presets, scaled by `scale` (0 < scale ≤ 1); `hr@0.125` gives a
+/// camera its own scale.
 pub fn parse_cameras(list: &str, scale: f64) -> anyhow::Result<Vec<eenf_sim::CameraConfig>> {
-    if !(scale > 0.0 && scale <= 1.0) {
-        anyhow::bail!("--video-scale must lie in (0, 1], not {scale}");
-    }
     list.split(',')
         .filter(|s| !s.trim().is_empty())
-        .map(|name| {
-            eenf_sim::CameraConfig::named(name.trim())
-                .map(|c| c.scaled(scale))
+        .map(|item| {
+            let (name, own) = match item.trim().split_once('@') {
+                Some((n, f)) => (
+                    n,
+                    f.parse::<f64>()
+                        .map_err(|_| anyhow::anyhow!("--video {item:?}: bad scale {f:?}"))?,
+                ),
+                None => (item.trim(), scale),
+            };
+            if !(own > 0.0 && own <= 1.0) {
+                anyhow::bail!("--video-scale must lie in (0, 1], not {own}");
+            }
+            eenf_sim::CameraConfig::named(name)
+                .map(|c| c.scaled(own))
                 .ok_or_else(|| anyhow::anyhow!("--video {name:?}: expected lr or hr"))
         })
         .collect()
@@ -408,7 +421,11 @@ pub fn write_video(
         let status = std::process::Command::new(&tool)
             .args(["-v", "error", "-y", "-i"])
             .arg(&y4m)
-            .args(["-c:v", "libx264", "-pix_fmt", "yuv420p", "-crf", "18"])
+            .args([
+                "-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p",
+            ])
+            .arg("-crf")
+            .arg(camera.crf.to_string())
             .arg(&mp4_path)
             .status();
         match status {

@@ -2,14 +2,14 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use eenf_cli::dataset::recording_start;
-use eenf_cli::output::{read_trace, times, TraceFile};
-use eenf_cli::pipeline::{align, reference_file, reference_for_recording, Nominal};
+use eenf_cli::evaluate::{self, Comparison, Reference};
+use eenf_cli::output::{read_trace, TraceFile};
+use eenf_cli::pipeline::Nominal;
 use eenf_cli::plot::plot_comparison;
 use eenf_cli::progress::Progress;
-use eenf_cli::wav::is_wav;
-use eenf_dsp::{agreement, Agreement, EnfParams};
+use eenf_dsp::EnfParams;
 
 use super::method::Peak;
 
@@ -39,26 +39,14 @@ pub struct Args {
     pub peak: Option<Peak>,
 }
 
-/// The outcome of a comparison.
-pub struct Comparison {
-    /// Metrics over the common seconds.
-    pub agreement: Agreement,
-    /// Times (s from the recording start) compared.
-    pub time_s: Vec<f64>,
-    /// Estimate at those times.
-    pub estimate: Vec<f64>,
-    /// Reference at those times.
-    pub reference: Vec<f64>,
-}
-
 /// The estimate's peak method, from its JSON metadata.
-fn estimate_peak(path: &Path) -> Option<eenf_dsp::PeakMethod> {
+pub fn estimate_peak(path: &Path) -> Option<eenf_dsp::PeakMethod> {
     let text = std::fs::read_to_string(path).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     serde_json::from_value(v["params"]["peak"].clone()).ok()
 }
 
-/// Compares `est` with the reference at `reference`.
+/// Compares the trace file `est` (read from `est_path`) with the reference at `reference`.
 pub fn compare(
     est: &TraceFile,
     est_path: &Path,
@@ -67,42 +55,23 @@ pub fn compare(
     nominal: Nominal,
     params: &EnfParams,
 ) -> Result<Comparison> {
-    let (ref_t, ref_v, offset) = if reference.is_dir() {
-        let source = est.source.clone().unwrap_or_else(|| est_path.to_path_buf());
-        let start = recording_start(&source)
-            .or_else(|| recording_start(est_path))
-            .with_context(|| {
-                format!(
-                    "{}: cannot tell when the recording started: its name has no dvSave-YYYY_MM_DD_HH_MM_SS",
-                    est_path.display()
-                )
-            })?;
-        let step = params.step_s;
-        let last = est.time_s.iter().copied().fold(0.0, f64::max);
-        let seconds = ((last + offset_s) / step).floor() as usize + 1;
-        let (_, trace) = reference_for_recording(reference, start, seconds, nominal, params)?;
-        (times(trace.len(), step), trace, offset_s)
-    } else if is_wav(reference) {
-        let (_, trace) = reference_file(reference, nominal, params)?;
-        (times(trace.len(), params.step_s), trace, offset_s)
+    let source = est.source.clone().unwrap_or_else(|| est_path.to_path_buf());
+    // the recording's name, else the trace file's own, says when it started
+    let named = if recording_start(&source).is_some() {
+        source
     } else {
-        let r = read_trace(reference)?;
-        (r.time_s, r.enf_hz, offset_s)
+        est_path.to_path_buf()
     };
-    let (t, e, r) = align(&est.time_s, &est.enf_hz, &ref_t, &ref_v, offset);
-    let Some(agreement) = agreement(&e, &r) else {
-        bail!(
-            "{} and {} share fewer than two seconds at offset {offset} s",
-            est_path.display(),
-            reference.display()
-        );
-    };
-    Ok(Comparison {
-        agreement,
-        time_s: t,
-        estimate: e,
-        reference: r,
-    })
+    let (reference, offset) = Reference::resolve(reference, &named, offset_s)?;
+    evaluate::compare(
+        &est.time_s,
+        &est.enf_hz,
+        est_path,
+        &reference,
+        offset,
+        nominal,
+        params,
+    )
 }
 
 pub fn run(a: Args, progress: Progress) -> Result<()> {

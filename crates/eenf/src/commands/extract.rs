@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use eenf_cli::output::{times, write_atomic, write_trace_csv};
+use eenf_cli::output::{extraction_json, times, write_atomic, write_trace_csv};
 use eenf_cli::pipeline::{extract_file, Extraction};
 use eenf_cli::plot::plot_extraction;
 use eenf_cli::progress::Progress;
@@ -28,53 +28,12 @@ pub struct Args {
     pub method: MethodArgs,
 }
 
-/// The JSON form of an extraction.
-pub fn to_json(x: &Extraction) -> serde_json::Value {
-    let t = times(x.trace.enf_hz.len(), x.trace.step_s);
-    let seg = x.trace.segment_len as f64 * x.trace.step_s;
-    let selected: Vec<_> = x
-        .trace
-        .selected
-        .iter()
-        .enumerate()
-        .map(|(i, m)| serde_json::json!({"start_s": i as f64 * seg, "harmonic": m}))
-        .collect();
-    let nan_to_null =
-        |v: &[f64]| -> Vec<Option<f64>> { v.iter().map(|f| f.is_finite().then_some(*f)).collect() };
-    let harmonics: Vec<_> = x
-        .trace
-        .harmonics
-        .iter()
-        .map(|h| {
-            serde_json::json!({"harmonic": h.harmonic, "center_hz": h.center_hz,
-                "enf_hz": nan_to_null(&h.enf_hz)})
-        })
-        .collect();
-    serde_json::json!({
-        "file": x.path,
-        "format": x.info.format,
-        "start_t_us": x.t0_us,
-        "start_utc": eenf_cli::output::utc_string(x.t0_us),
-        "events": x.events,
-        "duration_s": x.duration_s,
-        "nominal_hz": x.params.nominal_hz,
-        "sampling": x.sampling.name(),
-        "dt_us": x.dt_us,
-        "params": x.params,
-        "step_s": x.trace.step_s,
-        "time_s": t,
-        "enf_hz": nan_to_null(&x.trace.enf_hz),
-        "harmonics": harmonics,
-        "selected": selected,
-    })
-}
-
 /// Writes the trace to `path` as CSV or (by extension) JSON.
 pub fn save(x: &Extraction, path: &Path) -> Result<()> {
     let is_json = path.extension().and_then(|e| e.to_str()) == Some("json");
     write_atomic(path, |w| {
         if is_json {
-            serde_json::to_writer_pretty(&mut *w, &to_json(x))?;
+            serde_json::to_writer_pretty(&mut *w, &extraction_json(x))?;
             writeln!(w)?;
             Ok(())
         } else {
@@ -120,7 +79,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         eprintln!("plot written to {}", p.display());
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&to_json(&x))?);
+        println!("{}", serde_json::to_string_pretty(&extraction_json(&x))?);
     } else if a.output.is_none() {
         let stdout = std::io::stdout();
         let mut lock = stdout.lock();

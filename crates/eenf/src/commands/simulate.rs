@@ -75,17 +75,37 @@ pub struct Args {
     /// Output format: aedat4, evt2, evt3, dat, text (default: from the extension).
     #[arg(long)]
     pub format: Option<String>,
+    #[command(flatten)]
+    pub video: VideoArgs,
+}
+
+/// The conventional videos rendered beside a recording (shared by `simulate` and
+/// `simulate-dataset`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct VideoArgs {
     /// Also render the same scene through conventional cameras, comma-separated: `lr`
-    /// (webcam, 640x480, 30 fps) and/or `hr` (phone, 1920x1080, ISO 1600, 1/200 s), written
-    /// as NAME_lr.y4m / NAME_hr.y4m beside the recording.
+    /// (webcam, 640x480, 30 fps, anti-flicker exposure) and/or `hr` (phone, 1920x1080,
+    /// ISO 1600, 1/200 s), written as NAME_lr.y4m / NAME_hr.y4m beside the recording.
+    /// `hr@0.125` scales one camera's frame on its own.
     #[arg(long)]
     pub video: Option<String>,
     /// Scale the videos' frames by this factor (0..1], for speed.
     #[arg(long, default_value_t = 1.0)]
     pub video_scale: f64,
-    /// Also encode each video as MP4 (H.264) with ffmpeg.
+    /// Also encode each video as MP4 (H.264 at the camera's CRF: 28 webcam, 20 phone) with
+    /// ffmpeg, as the cameras' own pipelines do.
     #[arg(long)]
     pub mp4: bool,
+}
+
+impl VideoArgs {
+    /// The cameras asked for (none without `--video`).
+    pub fn cameras(&self) -> Result<Vec<eenf_sim::CameraConfig>> {
+        match &self.video {
+            Some(list) => eenf_cli::simulation::parse_cameras(list, self.video_scale),
+            None => Ok(Vec::new()),
+        }
+    }
 }
 
 impl Default for Args {
@@ -243,10 +263,7 @@ pub fn run(a: Args, progress: Progress) -> Result<Simulated> {
         "local_start": start,
         "utc_offset_s": tz,
     });
-    let cameras = match &a.video {
-        Some(list) => eenf_cli::simulation::parse_cameras(list, a.video_scale)?,
-        None => Vec::new(),
-    };
+    let cameras = a.video.cameras()?;
     let sim = write_recording(&config, &mains, &a.output, format, extra, &progress)?;
     eprintln!(
         "simulated {:.0} s at {}x{}: {} events ({:.1} M events/s generated) in {:.1} s",
@@ -266,9 +283,14 @@ pub fn run(a: Args, progress: Progress) -> Result<Simulated> {
     eprintln!("recording  {}", a.output.display());
     eprintln!("truth      {}", sim.truth.display());
     for camera in &cameras {
-        for p in
-            eenf_cli::simulation::write_video(&config, camera, &mains, &a.output, a.mp4, &progress)?
-        {
+        for p in eenf_cli::simulation::write_video(
+            &config,
+            camera,
+            &mains,
+            &a.output,
+            a.video.mp4,
+            &progress,
+        )? {
             eprintln!("video      {}", p.display());
         }
     }

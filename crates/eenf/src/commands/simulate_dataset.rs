@@ -7,19 +7,20 @@ use eenf_cli::dataset::StartTime;
 use eenf_cli::output::write_atomic;
 use eenf_cli::progress::Progress;
 use eenf_cli::refdb::tz_offset;
-use eenf_cli::simulation::{write_recording, EnfTimeline};
+use eenf_cli::simulation::{write_recording, write_video, EnfTimeline};
 use eenf_events::writers::OutputFormat;
 use eenf_sim::{Lamp, LampKind, Readout, SceneKind, SimConfig};
 use rand::{Rng, SeedableRng};
 
 use super::convert::parse_codec;
-use super::simulate::parse_resolution;
+use super::simulate::{parse_resolution, VideoArgs};
 
 /// Arguments of `eenf simulate-dataset`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
     /// Folder to create: `static/`, `dynamic/`, `extreme/` with `dvSave-*.aedat4` recordings
-    /// (and their `.truth.csv`, `.sim.json`), `ENF_Reference/` with hourly WAVs,
+    /// (and their `.truth.csv`, `.sim.json`, and with `--video` their `<stem>_lr.y4m` /
+    /// `<stem>_hr.y4m`), `ENF_Reference/` with hourly WAVs,
     /// `manifest.csv` and `dataset.json`.
     pub out_dir: PathBuf,
     /// `ev-enfd`: 51 recordings of 180 s (16 static, 25 dynamic, 10 extreme, the paper's
@@ -55,6 +56,8 @@ pub struct Args {
     /// Random seed of the whole dataset.
     #[arg(long, default_value_t = 2023)]
     pub seed: u64,
+    #[command(flatten)]
+    pub video: VideoArgs,
 }
 
 /// One planned recording.
@@ -163,6 +166,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let readout = Readout::named(&a.readout)
         .with_context(|| format!("--readout {:?}: expected dvxplorer or prophesee", a.readout))?;
     let codec = parse_codec(&a.compression)?;
+    let cameras = a.video.cameras()?;
     let tz = tz_offset(&a.tz)?;
 
     let timeline = match &a.enf_dir {
@@ -272,6 +276,13 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             &Progress::hidden(),
         )?;
         total_events += sim.stats.events;
+        let mut videos = Vec::new();
+        for camera in &cameras {
+            let hidden = Progress::hidden();
+            for v in write_video(&plan.config, camera, &mains, &path, a.video.mp4, &hidden)? {
+                videos.push(rel(&a.out_dir, &v));
+            }
+        }
         let lamps: Vec<String> = plan
             .config
             .lamps
@@ -285,11 +296,12 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             })
             .collect();
         rows.push(format!(
-            "{},{},{},{},,{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{}",
             rel(&a.out_dir, &path),
             plan.class,
             rel(&a.out_dir, &ref_dir.join(t.reference_name())),
             t.second_of_hour(),
+            videos.join(";"),
             kinds.join("+"),
             lamps.join("+"),
             duration,
@@ -319,6 +331,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         "utc_offset_s": tz,
         "seed": a.seed,
         "events": total_events,
+        "videos": cameras,
         "seconds": started.elapsed().as_secs_f64(),
     });
     write_atomic(&a.out_dir.join("dataset.json"), |w| {

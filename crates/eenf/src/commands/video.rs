@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
-use eenf_cli::output::{times, write_atomic, write_trace_csv};
+use eenf_cli::output::{times, video_json, write_atomic, write_trace_csv};
 use eenf_cli::progress::Progress;
 use eenf_dsp::{EnfParams, PeakMethod};
 use eenf_video::{
@@ -88,33 +88,6 @@ impl Args {
     }
 }
 
-/// The JSON form of a video trace (readable by `compare`).
-pub fn to_json(path: &Path, t: &VideoTrace, opts: &VideoOptions) -> serde_json::Value {
-    let enf: Vec<Option<f64>> = t
-        .enf_hz
-        .iter()
-        .map(|f| f.is_finite().then_some(*f))
-        .collect();
-    serde_json::json!({
-        "file": path,
-        "method": "v-enf",
-        "width": t.info.width,
-        "height": t.info.height,
-        "fps": t.info.fps,
-        "frames": t.frames,
-        "nominal_hz": t.nominal_hz,
-        "sampling": opts.sampling,
-        "scene_removal": opts.scene_removal,
-        "virtual_rows": t.virtual_rows,
-        "fs_hz": t.fs,
-        "line_hz": t.line_hz,
-        "prominence": t.prominence,
-        "step_s": t.step_s,
-        "time_s": times(t.enf_hz.len(), t.step_s),
-        "enf_hz": enf,
-    })
-}
-
 /// Traces `file`; the progress bar counts frames.
 pub fn trace_file(path: &Path, opts: &VideoOptions, progress: &Progress) -> Result<VideoTrace> {
     let mut source = FrameSource::open(path)?;
@@ -133,7 +106,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         let is_json = out.extension().and_then(|e| e.to_str()) == Some("json");
         write_atomic(out, |w| {
             if is_json {
-                serde_json::to_writer_pretty(&mut *w, &to_json(&a.file, &t, &opts))?;
+                serde_json::to_writer_pretty(&mut *w, &video_json(&a.file, &t, &opts))?;
                 writeln!(w)?;
                 Ok(())
             } else {
@@ -164,7 +137,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     if a.json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&to_json(&a.file, &t, &opts))?
+            serde_json::to_string_pretty(&video_json(&a.file, &t, &opts))?
         );
     } else if a.output.is_none() {
         let stdout = std::io::stdout();
