@@ -50,10 +50,28 @@ pub struct CameraConfig {
     /// 28 for a webcam streamed at ~1 Mbit/s, 20 for a phone's ~17 Mbit/s 1080p.
     #[serde(default = "default_crf")]
     pub crf: u32,
+    /// Error of the camera's clock, parts per million: frames come (1 + ppm·10⁻⁶) times a
+    /// nominal period apart while the file says the nominal rate (cameras are not locked to
+    /// anything; a phone's or webcam's crystal is off by tens of ppm).
+    #[serde(default)]
+    pub clock_ppm: f64,
+    /// Whether the gain follows the scene (locked on the first frame, up to `max_gain`); off,
+    /// the gain is fixed for an indoor room, as a phone set by hand to an ISO and a shutter
+    /// speed: a dim scene stays dark and a bright one clips.
+    #[serde(default = "default_true")]
+    pub auto_exposure: bool,
+    /// Random jitter of each frame's start, s rms (a phone's variable-rate video pipeline;
+    /// the file's timing says nothing of it).
+    #[serde(default)]
+    pub frame_jitter_s: f64,
 }
 
 fn default_crf() -> u32 {
     23
+}
+
+fn default_true() -> bool {
+    true
 }
 
 impl CameraConfig {
@@ -77,11 +95,15 @@ impl CameraConfig {
             max_gain: 3.0,
             anti_flicker: true,
             crf: 28,
+            clock_ppm: 0.0,
+            auto_exposure: true,
+            frame_jitter_s: 50e-6,
         }
     }
 
-    /// A phone camera like the dataset's Video-HR: 1920×1080, 30 fps, ISO 1600, 1/200 s,
-    /// ~20 ms readout.
+    /// A phone camera like the dataset's Video-HR: 1920×1080, 30 fps, set by hand to ISO 1600
+    /// and 1/200 s (no auto-exposure: dim scenes stay dark, bright ones clip), ~20 ms readout,
+    /// frame starts jittering by 0.5 ms as a phone's variable-rate pipeline does.
     pub fn hr() -> Self {
         CameraConfig {
             name: "hr".into(),
@@ -99,6 +121,9 @@ impl CameraConfig {
             max_gain: 40.0,
             anti_flicker: false,
             crf: 20,
+            clock_ppm: 0.0,
+            auto_exposure: false,
+            frame_jitter_s: 0.5e-3,
         }
     }
 
@@ -290,7 +315,11 @@ pub fn render_video<E>(
     };
     // the gain an indoor room (mean light ≈ 1) would get, and the cap relative to it
     let room_gain = camera.target;
-    let gain = (camera.target / mean_irr).min(room_gain * camera.max_gain);
+    let gain = if camera.auto_exposure {
+        (camera.target / mean_irr).min(room_gain * camera.max_gain)
+    } else {
+        room_gain
+    };
     let fs_e = camera.full_scale_e;
     let read = camera.read_noise_e / fs_e;
     let black = camera.black_level;
@@ -308,7 +337,8 @@ pub fn render_video<E>(
     let mut saturated = 0u64;
     let seed = config.seed ^ 0xCA3E_7A00;
     for n in 0..frames {
-        let t_frame = n as f64 * period;
+        let t_frame = n as f64 * period * (1.0 + camera.clock_ppm * 1e-6)
+            + camera.frame_jitter_s * f64::from(row_rng(seed ^ 0x7177, n, u64::MAX)());
         // exposure of row i: [end − exposure, end], end = t_frame + exposure + i·row_time
         let last_end = t_frame + exposure + (h - 1) as f64 * row_time;
         light.extend_to(last_end + light.dt, mains);
@@ -359,7 +389,8 @@ pub fn render_video<E>(
             .sum();
         saturated += clipped;
         sink(&frame)?;
-        light.forget_before(t_frame + period);
+        // the next frame starts after this one (jitter is far below a period)
+        light.forget_before(t_frame);
     }
     Ok(VideoStats {
         frames,
