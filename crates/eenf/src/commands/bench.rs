@@ -257,8 +257,23 @@ fn report(
         runs.len(),
         env!("CARGO_PKG_VERSION"),
     );
-    if a.plots.is_some() {
-        s.push_str("![CC and MAE per class and method](summary.png)\n\n");
+    if let (Some(plots), Some(report)) = (&a.plots, &a.report) {
+        // the figure's path as seen from the report's folder
+        let img = plots.join("summary.png");
+        let base = report.parent().unwrap_or(Path::new(""));
+        let shown = if base.as_os_str().is_empty() {
+            img.clone()
+        } else if let Ok(rel) = img.strip_prefix(base) {
+            rel.to_path_buf()
+        } else {
+            std::fs::canonicalize(plots)
+                .map(|p| p.join("summary.png"))
+                .unwrap_or(img)
+        };
+        s.push_str(&format!(
+            "![CC and MAE per class and method]({})\n\n",
+            shown.display()
+        ));
     }
     for run in runs {
         s.push_str(&markdown_run(recs, run, methods));
