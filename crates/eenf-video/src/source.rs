@@ -192,6 +192,20 @@ fn ffmpeg_program(name: &str) -> String {
     std::env::var(var).unwrap_or_else(|_| name.to_string())
 }
 
+/// The error of a tool that could not be started on `path`.
+fn tool_error(path: &Path, tool: &str, e: std::io::Error) -> VideoError {
+    VideoError::Tool {
+        path: path.to_path_buf(),
+        tool: tool.to_string(),
+        reason: if e.kind() == std::io::ErrorKind::NotFound {
+            "it is not installed (not a Y4M file, so ffmpeg is needed; Debian: apt install ffmpeg)"
+                .into()
+        } else {
+            e.to_string()
+        },
+    }
+}
+
 /// Any container ffmpeg can decode, piped as raw 8-bit gray frames.
 pub struct FfmpegSource {
     path: PathBuf,
@@ -219,15 +233,7 @@ impl FfmpegSource {
             ])
             .arg(path)
             .output()
-            .map_err(|e| VideoError::Tool {
-                path: path.to_path_buf(),
-                tool: probe.clone(),
-                reason: if e.kind() == std::io::ErrorKind::NotFound {
-                    "it is not installed (not a Y4M file, so ffmpeg is needed; Debian: apt install ffmpeg)".into()
-                } else {
-                    e.to_string()
-                },
-            })?;
+            .map_err(|e| tool_error(path, &probe, e))?;
         if !out.status.success() {
             let msg = String::from_utf8_lossy(&out.stderr);
             return Err(VideoError::bad(
@@ -271,15 +277,7 @@ impl FfmpegSource {
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()
-            .map_err(|e| VideoError::Tool {
-                path: path.to_path_buf(),
-                tool: tool.clone(),
-                reason: if e.kind() == std::io::ErrorKind::NotFound {
-                    "it is not installed (Debian: apt install ffmpeg)".into()
-                } else {
-                    e.to_string()
-                },
-            })?;
+            .map_err(|e| tool_error(path, &tool, e))?;
         let stdout = child.stdout.take().expect("piped");
         Ok(FfmpegSource {
             path: path.to_path_buf(),

@@ -547,91 +547,113 @@ pub fn evaluate(
     }
 }
 
-fn run_method(rec: &Recording, method: Method, s: &Settings, spectrum: bool) -> Result<Details> {
+/// A method's trace, before it is scored.
+struct Traced {
+    /// The file traced (events or video).
+    source: PathBuf,
+    /// Seconds between estimates.
+    step_s: f64,
+    /// The ENF, Hz.
+    enf_hz: Vec<f64>,
+    /// Peak refinement used (the reference is traced with it).
+    peak: PeakMethod,
+    /// Grid the trace was made on.
+    nominal_hz: f64,
+    /// E-ENF's per-harmonic traces.
+    trace: Option<EnfTrace>,
+    /// E-ENF's spectrogram around 2f0.
+    spectrogram: Option<Spectrogram>,
+    /// The trace as `extract`/`video` write it.
+    json: serde_json::Value,
+}
+
+/// E-ENF on the recording's events.
+fn trace_events(rec: &Recording, s: &Settings, spectrum: bool) -> Result<Traced> {
     let hidden = Progress::hidden();
-    let (source, time_s, enf_hz, params, trace, spec, nominal, json) = match method.camera() {
-        None => {
-            let o = &s.extract;
-            let (info, events, seq) = sample_file(&rec.path, o.sampling, o.dt_us, &hidden)?;
-            let x = extract_sequence(&rec.path, info, events, &seq, o, &hidden)?;
-            let f2 = 2.0 * x.params.nominal_hz;
-            let spec = spectrum.then(|| {
-                let v: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
-                spectrogram(
-                    &v,
-                    seq.fs(),
-                    x.params.window_s,
-                    x.params.step_s,
-                    (f2 - 2.0, f2 + 2.0),
-                )
-            });
-            let t = crate::output::times(x.trace.enf_hz.len(), x.trace.step_s);
-            let json = extraction_json(&x);
-            (
-                rec.path.clone(),
-                t,
-                x.trace.enf_hz.clone(),
-                x.params.clone(),
-                Some(x.trace),
-                spec,
-                x.params.nominal_hz,
-                json,
-            )
-        }
-        Some(camera) => {
-            let path = rec.video(camera).with_context(|| {
-                format!(
-                    "{}: no {camera} video beside it (<stem>_{camera}.y4m/.mp4/…)",
-                    rec.path.display()
-                )
-            })?;
-            let mut source = FrameSource::open(path)?;
-            let t = video_enf(&mut source, &s.video, |_| {})?;
-            let json = video_json(path, &t, &s.video);
-            let mut params = s.video.params.clone();
-            params.nominal_hz = t.nominal_hz;
-            (
-                path.to_path_buf(),
-                crate::output::times(t.enf_hz.len(), t.step_s),
-                t.enf_hz,
-                params,
-                None,
-                None,
-                t.nominal_hz,
-                json,
-            )
-        }
+    let o = &s.extract;
+    let (info, events, seq) = sample_file(&rec.path, o.sampling, o.dt_us, &hidden)?;
+    let x = extract_sequence(&rec.path, info, events, &seq, o, &hidden)?;
+    let f2 = 2.0 * x.params.nominal_hz;
+    let spectrogram = spectrum.then(|| {
+        let v: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
+        spectrogram(
+            &v,
+            seq.fs(),
+            x.params.window_s,
+            x.params.step_s,
+            (f2 - 2.0, f2 + 2.0),
+        )
+    });
+    Ok(Traced {
+        source: rec.path.clone(),
+        step_s: x.trace.step_s,
+        enf_hz: x.trace.enf_hz.clone(),
+        peak: x.params.peak,
+        nominal_hz: x.params.nominal_hz,
+        json: extraction_json(&x),
+        trace: Some(x.trace),
+        spectrogram,
+    })
+}
+
+/// V-ENF on the recording's video from `camera`.
+fn trace_video(rec: &Recording, camera: &str, s: &Settings) -> Result<Traced> {
+    let path = rec.video(camera).with_context(|| {
+        format!(
+            "{}: no {camera} video beside it (<stem>_{camera}.y4m/.mp4/…)",
+            rec.path.display()
+        )
+    })?;
+    let mut source = FrameSource::open(path)?;
+    let t = video_enf(&mut source, &s.video, |_| {})?;
+    Ok(Traced {
+        source: path.to_path_buf(),
+        step_s: t.step_s,
+        json: video_json(path, &t, &s.video),
+        enf_hz: t.enf_hz,
+        peak: s.video.params.peak,
+        nominal_hz: t.nominal_hz,
+        trace: None,
+        spectrogram: None,
+    })
+}
+
+fn run_method(rec: &Recording, method: Method, s: &Settings, spectrum: bool) -> Result<Details> {
+    let t = match method.camera() {
+        None => trace_events(rec, s, spectrum)?,
+        Some(camera) => trace_video(rec, camera, s)?,
     };
     // the reference is traced as `compare` traces it for this trace: default tracker with the
     // trace's peak refinement
     let ref_params = eenf_dsp::EnfParams {
-        peak: params.peak,
+        peak: t.peak,
         ..eenf_dsp::EnfParams::default()
     };
     let (reference, offset) = Reference::resolve(&rec.reference, &rec.path, rec.offset_s)?;
     let comparison = compare(
-        &time_s,
-        &enf_hz,
-        &source,
+        &crate::output::times(t.enf_hz.len(), t.step_s),
+        &t.enf_hz,
+        &t.source,
         &reference,
         offset,
         crate::pipeline::Nominal::Auto,
         &ref_params,
     )?;
     if let Some(f0) = comparison.nominal_hz {
-        if f0 != nominal {
+        if f0 != t.nominal_hz {
             bail!(
-                "{}: traced on a {nominal} Hz grid, but the reference is on {f0} Hz (the flicker found is not the mains')",
-                source.display()
+                "{}: traced on a {} Hz grid, but the reference is on {f0} Hz (the flicker found is not the mains')",
+                t.source.display(),
+                t.nominal_hz
             );
         }
     }
     Ok(Details {
         comparison,
-        trace,
-        spectrogram: spec,
-        nominal_hz: nominal,
-        json,
+        trace: t.trace,
+        spectrogram: t.spectrogram,
+        nominal_hz: t.nominal_hz,
+        json: t.json,
     })
 }
 
@@ -734,9 +756,9 @@ fn fmt_mhz(v_hz: f64) -> String {
     }
 }
 
-/// The Markdown report of one run: the Table 2 layout (eenf's rows with the best per column in
-/// bold, the paper's rows below), the recordings scored and failed, the per-recording rows.
-pub fn markdown_run(recs: &[Recording], run: &Run, methods: &[Method]) -> String {
+/// The Table 2 layout of one run: eenf's rows with the best per column in bold, the paper's
+/// rows below.
+pub fn markdown_table(run: &Run, methods: &[Method]) -> String {
     let classes = run.classes();
     let cell = |m: Method, c: &str| run.summary.iter().find(|s| s.method == m && s.class == c);
     let mut s = String::new();
@@ -800,6 +822,13 @@ pub fn markdown_run(recs: &[Recording], run: &Run, methods: &[Method]) -> String
         }
         s.push('\n');
     }
+    s
+}
+
+/// The Markdown report of one run: the Table 2 layout (eenf's rows with the best per column in
+/// bold, the paper's rows below), the recordings scored and failed, the per-recording rows.
+pub fn markdown_run(recs: &[Recording], run: &Run, methods: &[Method]) -> String {
+    let mut s = markdown_table(run, methods);
     s.push_str("\nBold: best of eenf's rows per column. Means over the recordings scored; a recording where a method fails (no flicker found, no video, bad file) is counted as failed and left out of that mean.\n\n");
     s.push_str("| recording | method | CC | MAE (mHz) | RMSE (mHz) | max error (mHz) | seconds | run (s) | error |\n|---|---|---|---|---|---|---|---|---|\n");
     for o in &run.outcomes {
@@ -831,17 +860,11 @@ pub fn markdown_run(recs: &[Recording], run: &Run, methods: &[Method]) -> String
 pub const CSV_HEADER: &str =
     "settings,recording,class,method,status,cc,mae_hz,rmse_hz,max_err_hz,seconds,run_s,error";
 
-/// CSV rows of a run: one per recording and method, then one `mean` row per class and method
-/// (recording `mean:<class>`, seconds = recordings scored).
-pub fn csv_rows(recs: &[Recording], run: &Run, out: &mut Vec<String>) {
-    let q = |s: &str| {
-        if s.contains([',', '"', '\n']) {
-            format!("\"{}\"", s.replace('"', "\"\""))
-        } else {
-            s.to_string()
-        }
-    };
-    let settings = q(&run.settings.describe());
+/// Writes the runs as CSV ([`CSV_HEADER`]): per run, one row per recording and method, then one
+/// `mean` row per class and method (recording `mean:<class>`, seconds = recordings scored).
+pub fn write_csv(w: &mut dyn std::io::Write, recs: &[Recording], runs: &[Run]) -> Result<()> {
+    let mut out = csv::Writer::from_writer(w);
+    out.write_record(CSV_HEADER.split(','))?;
     let num = |v: f64| {
         if v.is_finite() {
             format!("{v}")
@@ -849,49 +872,53 @@ pub fn csv_rows(recs: &[Recording], run: &Run, out: &mut Vec<String>) {
             String::new()
         }
     };
-    for o in &run.outcomes {
-        let r = &recs[o.recording];
-        match &o.result {
-            Ok(x) => out.push(format!(
-                "{settings},{},{},{},ok,{},{},{},{},{},{:.3},",
-                q(&r.name()),
-                q(&r.class),
-                o.method.name(),
-                num(x.cc),
-                num(x.mae_hz),
-                num(x.rmse_hz),
-                num(x.max_err_hz),
-                x.seconds,
-                o.run_s
-            )),
-            Err(e) => out.push(format!(
-                "{settings},{},{},{},failed,,,,,,{:.3},{}",
-                q(&r.name()),
-                q(&r.class),
-                o.method.name(),
-                o.run_s,
-                q(e)
-            )),
+    for run in runs {
+        let settings = run.settings.describe();
+        for o in &run.outcomes {
+            let r = &recs[o.recording];
+            let (status, x, error) = match &o.result {
+                Ok(x) => ("ok", Some(x), String::new()),
+                Err(e) => ("failed", None, e.clone()),
+            };
+            let score = |f: fn(&Scores) -> f64| x.map(|x| num(f(x))).unwrap_or_default();
+            out.write_record([
+                settings.clone(),
+                r.name(),
+                r.class.clone(),
+                o.method.name().to_string(),
+                status.to_string(),
+                score(|x| x.cc),
+                score(|x| x.mae_hz),
+                score(|x| x.rmse_hz),
+                score(|x| x.max_err_hz),
+                x.map(|x| x.seconds.to_string()).unwrap_or_default(),
+                format!("{:.3}", o.run_s),
+                error,
+            ])?;
+        }
+        for c in &run.summary {
+            out.write_record([
+                settings.clone(),
+                format!("mean:{}", c.class),
+                c.class.clone(),
+                c.method.name().to_string(),
+                if c.scored > 0 { "ok" } else { "failed" }.to_string(),
+                num(c.cc),
+                num(c.mae_hz),
+                num(c.rmse_hz),
+                String::new(),
+                c.scored.to_string(),
+                String::new(),
+                if c.failed > 0 {
+                    format!("{} failed", c.failed)
+                } else {
+                    String::new()
+                },
+            ])?;
         }
     }
-    for c in &run.summary {
-        out.push(format!(
-            "{settings},mean:{},{},{},{},{},{},{},,{},,{}",
-            q(&c.class),
-            q(&c.class),
-            c.method.name(),
-            if c.scored > 0 { "ok" } else { "failed" },
-            num(c.cc),
-            num(c.mae_hz),
-            num(c.rmse_hz),
-            c.scored,
-            if c.failed > 0 {
-                format!("{} failed", c.failed)
-            } else {
-                String::new()
-            }
-        ));
-    }
+    out.flush()?;
+    Ok(())
 }
 
 /// The JSON of a run.

@@ -50,28 +50,27 @@ impl Reference {
                 offset_s,
             ));
         }
-        if is_wav(path) {
-            if let (Some(hour), Some(dir)) = (reference_hour(path), path.parent()) {
-                if offset_s >= 0.0 && offset_s.fract() == 0.0 {
-                    let start =
-                        StartTime::from_local_seconds(hour.local_seconds() + offset_s as i64);
-                    let dir = if dir.as_os_str().is_empty() {
-                        Path::new(".")
-                    } else {
-                        dir
-                    };
-                    return Ok((
-                        Reference::Hourly {
-                            dir: dir.to_path_buf(),
-                            start,
-                        },
-                        0.0,
-                    ));
-                }
-            }
-            return Ok((Reference::Wav(path.to_path_buf()), offset_s));
+        if !is_wav(path) {
+            return Ok((Reference::Trace(path.to_path_buf()), offset_s));
         }
-        Ok((Reference::Trace(path.to_path_buf()), offset_s))
+        match reference_hour(path) {
+            // an hourly WAV and whole seconds into it: the folder form, from that second
+            Some(hour) if offset_s >= 0.0 && offset_s.fract() == 0.0 => {
+                let dir = path
+                    .parent()
+                    .filter(|d| !d.as_os_str().is_empty())
+                    .unwrap_or(Path::new("."));
+                let start = StartTime::from_local_seconds(hour.local_seconds() + offset_s as i64);
+                Ok((
+                    Reference::Hourly {
+                        dir: dir.to_path_buf(),
+                        start,
+                    },
+                    0.0,
+                ))
+            }
+            _ => Ok((Reference::Wav(path.to_path_buf()), offset_s)),
+        }
     }
 }
 

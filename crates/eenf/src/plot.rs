@@ -77,6 +77,14 @@ fn range(vals: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// The (t, v) pairs with a finite v, for line series that skip gaps.
+fn finite_points<'a>(t: &'a [f64], v: &'a [f64]) -> impl Iterator<Item = (f64, f64)> + 'a {
+    t.iter()
+        .zip(v)
+        .filter(|(_, v)| v.is_finite())
+        .map(|(a, b)| (*a, *b))
+}
+
 type Panel<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// The upper panel of both figures: ENF in Hz over time.
@@ -301,16 +309,10 @@ fn spectrogram_chart<DB: DrawingBackend>(
     }))
     .map_err(e)?;
     if let Some((t, f)) = line {
-        c.draw_series(LineSeries::new(
-            t.iter()
-                .zip(f)
-                .filter(|(_, v)| v.is_finite())
-                .map(|(a, b)| (*a, *b)),
-            WHITE.stroke_width(2),
-        ))
-        .map_err(e)?
-        .label("2 x reference ENF")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], WHITE.stroke_width(2)));
+        c.draw_series(LineSeries::new(finite_points(t, f), WHITE.stroke_width(2)))
+            .map_err(e)?
+            .label("2 x reference ENF")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], WHITE.stroke_width(2)));
         c.configure_series_labels()
             .background_style(BLACK.mix(0.5))
             .label_font(("sans-serif", 15).into_font().color(&WHITE))
@@ -569,10 +571,7 @@ fn extraction<DB: DrawingBackend>(
     for (k, h) in tr.harmonics.iter().enumerate() {
         let col = PALETTE[k % PALETTE.len()];
         c.draw_series(LineSeries::new(
-            t.iter()
-                .zip(&h.enf_hz)
-                .filter(|(_, v)| v.is_finite())
-                .map(|(a, b)| (*a, *b)),
+            finite_points(&t, &h.enf_hz),
             col.stroke_width(1),
         ))
         .map_err(e)?
@@ -580,10 +579,7 @@ fn extraction<DB: DrawingBackend>(
         .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col.stroke_width(2)));
     }
     c.draw_series(LineSeries::new(
-        t.iter()
-            .zip(&tr.enf_hz)
-            .filter(|(_, v)| v.is_finite())
-            .map(|(a, b)| (*a, *b)),
+        finite_points(&t, &tr.enf_hz),
         BLACK.stroke_width(3),
     ))
     .map_err(e)?

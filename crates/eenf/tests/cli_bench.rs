@@ -2,34 +2,8 @@
 //! equal `eenf compare` on the same traces, a manifest with a recording across an hour and a
 //! corrupt file, sweeps, and clear errors (also for `eenf video`).
 
-use std::path::Path;
-use std::process::Command;
-
-fn eenf(args: &[&str], dir: &Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_eenf"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
-
-fn ok(args: &[&str], dir: &Path) -> String {
-    let out = eenf(args, dir);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn fails(args: &[&str], dir: &Path) -> String {
-    let out = eenf(args, dir);
-    assert!(!out.status.success(), "{args:?} should fail");
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
-    err
-}
+mod cli;
+use cli::{eenf, fails, ok};
 
 /// Rows of a CSV with a header, as maps.
 fn csv_maps(text: &str) -> Vec<std::collections::HashMap<String, String>> {

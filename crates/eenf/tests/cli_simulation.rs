@@ -2,30 +2,8 @@
 //! ENF from a trace CSV, a dataset laid out like EV-ENFD with references that agree with the
 //! truth, and the same seed giving the same files.
 
-use std::path::Path;
-use std::process::Command;
-
-fn eenf(args: &[&str], dir: &Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_eenf"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
-
-fn ok(args: &[&str], dir: &Path) -> String {
-    let out = eenf(args, dir);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn json(text: &str) -> serde_json::Value {
-    serde_json::from_str(text).unwrap()
-}
+mod cli;
+use cli::{eenf, json, ok};
 
 #[test]
 fn a_small_dataset_is_laid_out_like_ev_enfd_and_its_references_match_the_truth() {

@@ -5,21 +5,9 @@
 mod common;
 
 use std::path::Path;
-use std::process::Command;
 
-fn ok(args: &[&str], dir: &Path) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_eenf"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
+mod cli;
+use cli::ok;
 
 #[test]
 #[ignore = "needs ../shared"]

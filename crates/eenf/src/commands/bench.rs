@@ -4,8 +4,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use eenf_cli::bench::{
-    csv_rows, discover, evaluate, json_run, markdown_run, paper_value, summarize, sweep, Method,
-    Outcome, Recording, Run, Settings, CSV_HEADER,
+    discover, evaluate, json_run, markdown_run, markdown_table, paper_value, summarize, sweep,
+    write_csv, Method, Outcome, Recording, Run, Settings,
 };
 use eenf_cli::output::write_atomic;
 use eenf_cli::pipeline::Nominal;
@@ -167,9 +167,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
 
     // the tables on stdout; failures on stderr
     for run in &runs {
-        let md = markdown_run(&recs, run, &methods);
-        let table_end = md.find("\nBold:").unwrap_or(md.len());
-        println!("{}", &md[..table_end]);
+        println!("{}", markdown_table(run, &methods));
         for o in run.outcomes.iter() {
             if let Err(e) = &o.result {
                 eprintln!(
@@ -205,17 +203,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         eprintln!("report written to {}", p.display());
     }
     if let Some(p) = &a.csv {
-        let mut rows = Vec::new();
-        for run in &runs {
-            csv_rows(&recs, run, &mut rows);
-        }
-        write_atomic(p, |w| {
-            writeln!(w, "{CSV_HEADER}")?;
-            for r in &rows {
-                writeln!(w, "{r}")?;
-            }
-            Ok(())
-        })?;
+        write_atomic(p, |w| write_csv(w, &recs, &runs))?;
         eprintln!("CSV written to {}", p.display());
     }
     if let Some(p) = &a.json {

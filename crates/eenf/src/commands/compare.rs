@@ -40,7 +40,7 @@ pub struct Args {
 }
 
 /// The estimate's peak method, from its JSON metadata.
-pub fn estimate_peak(path: &Path) -> Option<eenf_dsp::PeakMethod> {
+fn estimate_peak(path: &Path) -> Option<eenf_dsp::PeakMethod> {
     let text = std::fs::read_to_string(path).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     serde_json::from_value(v["params"]["peak"].clone()).ok()

@@ -1,0 +1,39 @@
+//! Running the `eenf` binary from the CLI tests, as a user does.
+#![allow(dead_code)] // each test target uses some of these
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Runs `eenf ARGS` in `dir`.
+pub fn eenf(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_eenf"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+/// Runs `eenf ARGS`, which must succeed; its stdout.
+pub fn ok(args: &[&str], dir: &Path) -> String {
+    let out = eenf(args, dir);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Runs `eenf ARGS`, which must fail without a panic; its stderr.
+pub fn fails(args: &[&str], dir: &Path) -> String {
+    let out = eenf(args, dir);
+    assert!(!out.status.success(), "{args:?} should fail");
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    err
+}
+
+/// Parses JSON output.
+pub fn json(text: &str) -> serde_json::Value {
+    serde_json::from_str(text).unwrap()
+}
