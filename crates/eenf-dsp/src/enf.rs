@@ -102,7 +102,7 @@ pub enum DspError {
 
 /// The ENF traced on one flicker harmonic.
 #[derive(Debug, Clone, serde::Serialize)]
-pub struct HarmonicTrace {
+pub struct HarmonicEstimates {
     /// Harmonic number m: the band is centred on 2m·f0.
     pub harmonic: usize,
     /// Band centre, Hz.
@@ -113,13 +113,13 @@ pub struct HarmonicTrace {
 
 /// An ENF trace and how it was assembled.
 #[derive(Debug, Clone, serde::Serialize)]
-pub struct EnfTrace {
+pub struct EnfEstimates {
     /// Seconds between estimates; estimate i is centred at i·step_s from the start.
     pub step_s: f64,
     /// The ENF, Hz.
     pub enf_hz: Vec<f64>,
     /// Per-harmonic traces.
-    pub harmonics: Vec<HarmonicTrace>,
+    pub harmonics: Vec<HarmonicEstimates>,
     /// Harmonic number chosen in each segment.
     pub selected: Vec<usize>,
     /// Segment length of the selection, in estimates.
@@ -127,13 +127,13 @@ pub struct EnfTrace {
 }
 
 /// E-ENF from a polarity sequence (the output of the temporal sampler).
-pub fn extract_enf(seq: &PolaritySequence, p: &EnfParams) -> Result<EnfTrace, DspError> {
+pub fn extract_enf(seq: &PolaritySequence, p: &EnfParams) -> Result<EnfEstimates, DspError> {
     let x: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
     enf_from_flicker(&x, seq.fs(), p)
 }
 
 /// The ENF from any signal that flickers at 2·f_e and its harmonics, sampled at `fs`.
-pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfTrace, DspError> {
+pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimates, DspError> {
     let duration_s = x.len() as f64 / fs;
     if duration_s < p.window_s {
         return Err(DspError::TooShort {
@@ -152,7 +152,7 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfTrace, D
         });
     }
     let tracker = p.tracker(fs);
-    let harmonics: Vec<HarmonicTrace> = bands
+    let harmonics: Vec<HarmonicEstimates> = bands
         .par_iter()
         .map(|&m| {
             let center = 2.0 * m as f64 * p.nominal_hz;
@@ -167,7 +167,7 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfTrace, D
             } else {
                 on_2f0
             };
-            HarmonicTrace {
+            HarmonicEstimates {
                 harmonic: m,
                 center_hz: center,
                 enf_hz: corrected.iter().map(|f| f / 2.0).collect(),
@@ -179,7 +179,7 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfTrace, D
     if enf_hz.iter().all(|v| !v.is_finite()) {
         return Err(DspError::NoTone("the flicker bands hold no signal".into()));
     }
-    Ok(EnfTrace {
+    Ok(EnfEstimates {
         step_s: p.step_s,
         enf_hz,
         selected: chosen.iter().map(|&i| harmonics[i].harmonic).collect(),

@@ -30,7 +30,7 @@ pub mod tracker;
 pub use butter::{butter_bandpass, sos_to_ba, Section};
 pub use enf::{
     check_line, detect_nominal, enf_from_flicker, extract_enf, line_prominence, reference_enf,
-    DspError, EnfParams, EnfTrace, HarmonicTrace,
+    DspError, EnfParams, EnfEstimates, HarmonicEstimates,
 };
 pub use filtfilt::sosfiltfilt;
 pub use metrics::{agreement, Agreement};

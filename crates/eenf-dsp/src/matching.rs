@@ -4,6 +4,8 @@
 use std::sync::Arc;
 
 use rayon::prelude::*;
+
+use crate::metrics::Agreement;
 use realfft::num_complex::Complex64;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 
@@ -27,14 +29,8 @@ pub struct MatchOptions {
 pub struct Verification {
     /// The offset checked.
     pub offset: usize,
-    /// Pearson correlation there.
-    pub cc: f64,
-    /// Mean absolute difference there, Hz.
-    pub mae_hz: f64,
-    /// Root-mean-square difference there, Hz.
-    pub rmse_hz: f64,
-    /// Values compared.
-    pub overlap: usize,
+    /// CC, MAE, RMSE, max error and values compared there.
+    pub agreement: Agreement,
     /// 1 + the number of offsets (farther than the exclusion zone) that score better.
     pub rank: usize,
     /// Significance of its score, as for candidates.
@@ -50,6 +46,28 @@ pub enum Score {
     Combined,
     /// Normalised cross-correlation alone (shape only; robust to a constant bias).
     Cc,
+}
+
+impl Score {
+    /// Every score, by its command-line name.
+    pub const NAMES: [&'static str; 2] = ["combined", "cc"];
+}
+
+impl std::fmt::Display for Score {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(Self::NAMES[*self as usize])
+    }
+}
+
+impl std::str::FromStr for Score {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "combined" => Ok(Score::Combined),
+            "cc" => Ok(Score::Cc),
+            _ => Err(format!("{s:?}: expected combined or cc")),
+        }
+    }
 }
 
 impl Default for MatchOptions {
@@ -70,14 +88,8 @@ pub struct Candidate {
     /// Offset of the trace's first value in the reference, in steps (fractional after
     /// refinement of the correlation peak).
     pub offset: f64,
-    /// Pearson correlation at the integer offset.
-    pub cc: f64,
-    /// Mean absolute difference at the integer offset, Hz.
-    pub mae_hz: f64,
-    /// Root-mean-square difference at the integer offset, Hz.
-    pub rmse_hz: f64,
-    /// Values compared.
-    pub overlap: usize,
+    /// CC, MAE, RMSE, max error and values compared at the integer offset.
+    pub agreement: Agreement,
     /// Probability that the best of all offsets of unrelated data scores this well.
     pub p_value: f64,
 }
@@ -217,9 +229,11 @@ pub fn resample(x: &[f64], from_step: f64, to_step: f64) -> Vec<f64> {
 }
 
 /// Pearson CC, MAE and RMSE of `q` against `r[k..k + q.len()]` over the values valid in both.
-fn score_at<R: ReferenceValues + ?Sized>(q: &[f64], r: &R, k: usize) -> (f64, f64, f64, usize) {
-    let (mut n, mut sq, mut sr, mut sqq, mut srr, mut sqr, mut abs, mut sq_err) =
-        (0usize, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+fn score_at<R: ReferenceValues + ?Sized>(q: &[f64], r: &R, k: usize) -> Agreement {
+    // one pass of running sums (this runs per candidate over long references); the two-pass
+    // [`crate::agreement`] is kept for comparisons, whose numbers it defines
+    let (mut n, mut sq, mut sr, mut sqq, mut srr, mut sqr, mut abs, mut sq_err, mut max) =
+        (0usize, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0f64);
     for (i, a) in q.iter().enumerate() {
         let b = &r.get(k + i);
         if a.is_finite() && b.is_finite() {
@@ -231,16 +245,28 @@ fn score_at<R: ReferenceValues + ?Sized>(q: &[f64], r: &R, k: usize) -> (f64, f6
             sqr += a * b;
             abs += (a - b).abs();
             sq_err += (a - b) * (a - b);
+            max = max.max((a - b).abs());
         }
     }
     if n < 3 {
-        return (f64::NAN, f64::NAN, f64::NAN, n);
+        return Agreement {
+            cc: f64::NAN,
+            mae_hz: f64::NAN,
+            rmse_hz: f64::NAN,
+            max_err_hz: f64::NAN,
+            n,
+        };
     }
     let nf = n as f64;
     let cov = sqr - sq * sr / nf;
     let den = ((sqq - sq * sq / nf) * (srr - sr * sr / nf)).sqrt();
-    let cc = if den > 0.0 { cov / den } else { f64::NAN };
-    (cc, abs / nf, (sq_err / nf).sqrt(), n)
+    Agreement {
+        cc: if den > 0.0 { cov / den } else { f64::NAN },
+        mae_hz: abs / nf,
+        rmse_hz: (sq_err / nf).sqrt(),
+        max_err_hz: max,
+        n,
+    }
 }
 
 /// A monotone stand-in for [`statistic`] that needs no logarithm, kept for every offset:
@@ -373,8 +399,8 @@ fn scores_all<R: ReferenceValues + ?Sized>(
                     let sse = q_abs_sq - 2.0 * (buf[k] + q_mean * s) + ss;
                     (cc, (sse.max(0.0) * inv_m).sqrt())
                 } else if m - gaps >= min_valid {
-                    let (cc, _, e, _) = score_at(&q_raw, r, start + k);
-                    (cc, e)
+                    let a = score_at(&q_raw, r, start + k);
+                    (a.cc, a.rmse_hz)
                 } else {
                     (f64::NAN, f64::NAN)
                 };
@@ -471,7 +497,7 @@ pub fn match_trace<R: ReferenceValues + ?Sized>(
     let candidates = picked
         .into_iter()
         .map(|k| {
-            let (c, mae, rmse, overlap) = score_at(&filled, reference, k);
+            let agreement = score_at(&filled, reference, k);
             // sub-step offset from a parabola through the neighbouring scores
             let at = |i: Option<usize>| {
                 i.and_then(|i| cc.get(i))
@@ -492,16 +518,13 @@ pub fn match_trace<R: ReferenceValues + ?Sized>(
             };
             Candidate {
                 offset: k as f64 + frac,
-                cc: c,
-                mae_hz: mae,
-                rmse_hz: rmse,
-                overlap,
+                agreement,
                 p_value: tail.p_value(stat(cc[k])),
             }
         })
         .collect();
     let verification = opts.verify.and_then(|k| {
-        let (c, mae, rmse, overlap) = score_offset(trace, reference, k)?;
+        let agreement = score_offset(trace, reference, k)?;
         let key = cc.get(k).copied().filter(|v| v.is_finite())?;
         let sk = stat(key);
         let better = cc
@@ -511,10 +534,7 @@ pub fn match_trace<R: ReferenceValues + ?Sized>(
             .count();
         Some(Verification {
             offset: k,
-            cc: c,
-            mae_hz: mae,
-            rmse_hz: rmse,
-            overlap,
+            agreement,
             rank: better + 1,
             p_value: tail.p_value(sk),
         })
@@ -574,12 +594,12 @@ fn best_offsets(keys: &[f32], top: usize, exclusion: usize) -> Vec<usize> {
     picked
 }
 
-/// CC, MAE, RMSE and overlap at one offset, for checking a claimed time.
+/// CC, MAE, RMSE, max error and overlap at one offset, for checking a claimed time.
 pub fn score_offset<R: ReferenceValues + ?Sized>(
     trace: &[f64],
     reference: &R,
     k: usize,
-) -> Option<(f64, f64, f64, usize)> {
+) -> Option<Agreement> {
     if k + trace.len() > reference.len() {
         return None;
     }
@@ -685,7 +705,7 @@ mod tests {
         let res = match_trace(&clip, &reference[..], &MatchOptions::default()).unwrap();
         let best = res.candidates[0];
         assert_eq!(best.offset.round() as usize, at, "{res:?}");
-        assert!(best.cc > 0.9, "{best:?}");
+        assert!(best.agreement.cc > 0.9, "{best:?}");
         assert!(best.p_value < DEFAULT_ALPHA, "{best:?}");
         assert!(res.candidates[1].p_value > best.p_value);
     }
@@ -711,7 +731,8 @@ mod tests {
             Score::Combined,
         );
         for k in [0, 1, 29_990, 30_010, 32_468, 32_469, 32_668, 65_437, 69_700] {
-            let (direct, _, direct_rmse, _) = score_at(&filled, &reference[..], k);
+            let a = score_at(&filled, &reference[..], k);
+            let (direct, direct_rmse) = (a.cc, a.rmse_hz);
             let gaps = reference[k..k + 300].iter().filter(|v| v.is_nan()).count();
             if 300 - gaps >= 240 {
                 let want = statistic(Score::Cc, direct, direct_rmse);

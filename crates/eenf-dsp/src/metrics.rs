@@ -11,7 +11,8 @@ pub struct Agreement {
     pub rmse_hz: f64,
     /// Largest absolute error, Hz.
     pub max_err_hz: f64,
-    /// Number of estimates compared.
+    /// Number of estimates compared (seconds at the usual 1 s step; `seconds` in JSON).
+    #[serde(rename = "seconds")]
     pub n: usize,
 }
 

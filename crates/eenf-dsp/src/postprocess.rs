@@ -43,6 +43,34 @@ pub enum HarmonicSelection {
     Consensus(f64),
 }
 
+impl HarmonicSelection {
+    /// Every rule, by its command-line name.
+    pub const NAMES: [&'static str; 2] = ["smoothest", "consensus"];
+    /// The consensus rule's default tolerance, Hz.
+    pub const DEFAULT_AGREE_HZ: f64 = 0.005;
+}
+
+impl std::fmt::Display for HarmonicSelection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            HarmonicSelection::Smoothest => "smoothest",
+            HarmonicSelection::Consensus(_) => "consensus",
+        })
+    }
+}
+
+/// `consensus` takes the default tolerance.
+impl std::str::FromStr for HarmonicSelection {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "smoothest" => Ok(HarmonicSelection::Smoothest),
+            "consensus" => Ok(HarmonicSelection::Consensus(Self::DEFAULT_AGREE_HZ)),
+            _ => Err(format!("{s:?}: expected smoothest or consensus")),
+        }
+    }
+}
+
 /// Picks a trace per segment of `segment` estimates. `traces` are on a common scale (the ENF).
 /// Returns the combined trace and the index of the trace chosen for each segment.
 pub fn select_harmonics(

@@ -17,13 +17,27 @@ pub enum SamplingMethod {
 }
 
 impl SamplingMethod {
-    /// Name as used on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            SamplingMethod::Paper => "paper",
-            SamplingMethod::Authors => "authors",
-            SamplingMethod::Block => "block",
-        }
+    /// Every variant, by its command-line name.
+    pub const NAMES: [&'static str; 3] = ["paper", "authors", "block"];
+    const ALL: [SamplingMethod; 3] = [
+        SamplingMethod::Paper,
+        SamplingMethod::Authors,
+        SamplingMethod::Block,
+    ];
+}
+
+impl std::fmt::Display for SamplingMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(Self::NAMES[*self as usize])
+    }
+}
+
+impl std::str::FromStr for SamplingMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let i = Self::NAMES.iter().position(|n| *n == s);
+        i.map(|i| Self::ALL[i])
+            .ok_or_else(|| format!("{s:?}: expected {}", Self::NAMES.join(", ")))
     }
 }
 

@@ -20,11 +20,23 @@ pub enum PeakMethod {
 }
 
 impl PeakMethod {
-    /// Name as used on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            PeakMethod::Exact => "exact",
-            PeakMethod::Paper => "paper",
+    /// Every variant, by its command-line name.
+    pub const NAMES: [&'static str; 2] = ["exact", "paper"];
+}
+
+impl std::fmt::Display for PeakMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(Self::NAMES[*self as usize])
+    }
+}
+
+impl std::str::FromStr for PeakMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "exact" => Ok(PeakMethod::Exact),
+            "paper" => Ok(PeakMethod::Paper),
+            _ => Err(format!("{s:?}: expected exact or paper")),
         }
     }
 }

@@ -27,7 +27,7 @@ pub mod text;
 pub mod writers;
 
 use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 pub use aedat4::{Aedat4Reader, Aedat4Writer, Compression};
 pub use batch::EventBatch;
@@ -233,40 +233,5 @@ impl StreamStats {
             s.add(&b);
         }
         Ok(s)
-    }
-}
-
-/// True when `path` exists and is not a regular file (a device such as `/dev/null`, a FIFO):
-/// such a target is written into, never replaced.
-pub fn is_special_file(path: &Path) -> bool {
-    std::fs::metadata(path)
-        .map(|m| !m.is_file() && !m.is_dir())
-        .unwrap_or(false)
-}
-
-/// A temporary path for writing `path` whole before [`commit_tmp`] puts it in place: beside
-/// it, or in the system's temporary folder when the target is a special file.
-pub fn tmp_path_for(path: &Path) -> PathBuf {
-    let mut name = path.file_name().unwrap_or_default().to_os_string();
-    name.push(format!(".{}.tmp", std::process::id()));
-    if is_special_file(path) {
-        std::env::temp_dir().join(name)
-    } else {
-        path.with_file_name(name)
-    }
-}
-
-/// Moves a finished temporary file into place: renamed over a regular file, copied into a
-/// special file (renaming over `/dev/null` would replace the device).
-pub fn commit_tmp(tmp: &Path, path: &Path) -> std::io::Result<()> {
-    if is_special_file(path) {
-        let res = std::fs::File::open(tmp).and_then(|mut src| {
-            let mut dst = std::fs::OpenOptions::new().write(true).open(path)?;
-            std::io::copy(&mut src, &mut dst).map(|_| ())
-        });
-        let _ = std::fs::remove_file(tmp);
-        res
-    } else {
-        std::fs::rename(tmp, path)
     }
 }

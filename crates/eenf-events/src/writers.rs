@@ -1,8 +1,7 @@
-//! Writers for every output format, behind one trait, each writing to a temporary file that is
-//! renamed into place by `finish` (an unfinished writer leaves nothing behind).
+//! Writers for every output format, behind one trait, over any seekable byte sink. Writing a
+//! file whole or not at all (a temporary file renamed into place) is the caller's job.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{io_err, EventError, Result};
@@ -12,9 +11,13 @@ use crate::{Aedat4Writer, Compression, EventBatch};
 pub trait EventWriter {
     /// Appends events (in time order).
     fn write(&mut self, batch: &EventBatch) -> Result<()>;
-    /// Completes the file and moves it into place; returns the number of events written.
+    /// Completes the file and flushes it; returns the number of events written.
     fn finish(self: Box<Self>) -> Result<u64>;
 }
+
+/// Where a writer's bytes go: a file, a temporary file, a `Cursor<Vec<u8>>`.
+pub trait Sink: Write + Seek + Send {}
+impl<T: Write + Seek + Send> Sink for T {}
 
 /// Output formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,27 +34,43 @@ pub enum OutputFormat {
     Text,
 }
 
-impl OutputFormat {
-    /// Parses `aedat4`, `evt2`, `evt3`, `dat`, `text`.
-    pub fn parse(name: &str, compression: Compression) -> Option<Self> {
-        Some(match name.to_ascii_lowercase().as_str() {
-            "aedat4" | "aedat" => OutputFormat::Aedat4(compression),
+/// `aedat4` (LZ4; see [`OutputFormat::with_compression`]), `evt2`, `evt3`, `dat`, `text`.
+impl std::str::FromStr for OutputFormat {
+    type Err = String;
+    fn from_str(name: &str) -> std::result::Result<Self, String> {
+        Ok(match name.to_ascii_lowercase().as_str() {
+            "aedat4" | "aedat" => OutputFormat::Aedat4(Compression::Lz4),
             "evt2" | "evt2.0" => OutputFormat::Evt2,
             "evt3" | "evt3.0" => OutputFormat::Evt3,
             "dat" => OutputFormat::Dat,
             "text" | "txt" => OutputFormat::Text,
-            _ => return None,
+            _ => return Err(format!("{name:?}: expected aedat4, evt2, evt3, dat or text")),
         })
     }
+}
 
-    /// A short name for messages.
-    pub fn name(&self) -> String {
+/// A short name for messages, e.g. `AEDAT 4.0 LZ4`, `EVT 3.0`.
+impl std::fmt::Display for OutputFormat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            OutputFormat::Aedat4(c) => format!("AEDAT 4.0 {}", c.name()),
-            OutputFormat::Evt2 => "EVT 2.0".into(),
-            OutputFormat::Evt3 => "EVT 3.0".into(),
-            OutputFormat::Dat => "DAT".into(),
-            OutputFormat::Text => "text".into(),
+            OutputFormat::Aedat4(c) => write!(f, "AEDAT 4.0 {}", c.name()),
+            OutputFormat::Evt2 => f.write_str("EVT 2.0"),
+            OutputFormat::Evt3 => f.write_str("EVT 3.0"),
+            OutputFormat::Dat => f.write_str("DAT"),
+            OutputFormat::Text => f.write_str("text"),
+        }
+    }
+}
+
+impl OutputFormat {
+    /// Every format, by its command-line name.
+    pub const NAMES: [&'static str; 5] = ["aedat4", "evt2", "evt3", "dat", "text"];
+
+    /// The same format with AEDAT4 packets compressed by `compression`.
+    pub fn with_compression(self, compression: Compression) -> Self {
+        match self {
+            OutputFormat::Aedat4(_) => OutputFormat::Aedat4(compression),
+            other => other,
         }
     }
 
@@ -68,19 +87,34 @@ impl OutputFormat {
     }
 }
 
-/// Creates a writer for `format` at `path` for a sensor of `width` × `height`.
+/// Creates a plain file at `path` and a writer for `format` into it, for a sensor of
+/// `width` × `height`.
 pub fn create(
     path: &Path,
     format: OutputFormat,
     width: u16,
     height: u16,
 ) -> Result<Box<dyn EventWriter>> {
+    let file = std::fs::File::create(path).map_err(|e| io_err(path, e))?;
+    writer(Box::new(file), path, format, width, height)
+}
+
+/// A writer for `format` into `out` (named `name` in errors), for a sensor of
+/// `width` × `height`.
+pub fn writer(
+    out: Box<dyn Sink>,
+    name: &Path,
+    format: OutputFormat,
+    width: u16,
+    height: u16,
+) -> Result<Box<dyn EventWriter>> {
+    let file = Output::new(out, name);
     Ok(match format {
-        OutputFormat::Aedat4(c) => Box::new(Aedat4Writer::create(path, c, width, height)?),
-        OutputFormat::Evt2 => Box::new(WordWriter::new(path, width, height, Evt2Enc::default())?),
-        OutputFormat::Evt3 => Box::new(WordWriter::new(path, width, height, Evt3Enc::default())?),
-        OutputFormat::Dat => Box::new(WordWriter::new(path, width, height, DatEnc)?),
-        OutputFormat::Text => Box::new(TextWriter::new(path)?),
+        OutputFormat::Aedat4(c) => Box::new(Aedat4Writer::new(file.out, name, c, width, height)?),
+        OutputFormat::Evt2 => Box::new(WordWriter::new(file, width, height, Evt2Enc::default())),
+        OutputFormat::Evt3 => Box::new(WordWriter::new(file, width, height, Evt3Enc::default())),
+        OutputFormat::Dat => Box::new(WordWriter::new(file, width, height, DatEnc)),
+        OutputFormat::Text => Box::new(TextWriter::new(file)?),
     })
 }
 
@@ -93,62 +127,55 @@ impl EventWriter for Aedat4Writer {
     }
 }
 
-/// A file written under a temporary name and renamed when complete.
-struct AtomicFile {
+/// A named, buffered sink.
+struct Output {
     path: PathBuf,
-    tmp: PathBuf,
-    out: Option<BufWriter<File>>,
+    out: Box<dyn Sink>,
 }
 
-impl AtomicFile {
-    fn create(path: &Path) -> Result<Self> {
-        let tmp = crate::tmp_path_for(path);
-        let f = File::create(&tmp).map_err(|e| io_err(&tmp, e))?;
-        Ok(AtomicFile {
-            path: path.to_path_buf(),
-            tmp,
-            out: Some(BufWriter::with_capacity(1 << 20, f)),
-        })
-    }
-
-    fn write_all(&mut self, bytes: &[u8]) -> Result<()> {
-        let tmp = &self.tmp;
-        self.out
-            .as_mut()
-            .expect("written after finish")
-            .write_all(bytes)
-            .map_err(|e| io_err(tmp, e))
-    }
-
-    fn commit(mut self) -> Result<()> {
-        let w = self.out.take().expect("committed once");
-        let f = w
-            .into_inner()
-            .map_err(|e| io_err(&self.tmp, e.into_error()))?;
-        f.sync_all().map_err(|e| io_err(&self.tmp, e))?;
-        crate::commit_tmp(&self.tmp, &self.path).map_err(|e| io_err(&self.path, e))
-    }
+/// The buffered form of [`Output`].
+struct Buffered {
+    path: PathBuf,
+    out: BufWriter<Box<dyn Sink>>,
 }
 
-impl Drop for AtomicFile {
-    fn drop(&mut self) {
-        if self.out.take().is_some() {
-            let _ = std::fs::remove_file(&self.tmp);
+impl Output {
+    fn new(out: Box<dyn Sink>, name: &Path) -> Self {
+        Output {
+            path: name.to_path_buf(),
+            out,
+        }
+    }
+
+    fn buffered(self) -> Buffered {
+        Buffered {
+            path: self.path,
+            out: BufWriter::with_capacity(1 << 20, self.out),
         }
     }
 }
 
+impl Buffered {
+    fn write_all(&mut self, bytes: &[u8]) -> Result<()> {
+        self.out.write_all(bytes).map_err(|e| io_err(&self.path, e))
+    }
+
+    fn commit(mut self) -> Result<()> {
+        self.out.flush().map_err(|e| io_err(&self.path, e))
+    }
+}
+
 /// Writes text events.
-pub struct TextWriter {
-    file: AtomicFile,
+struct TextWriter {
+    file: Buffered,
     line: String,
     count: u64,
 }
 
 impl TextWriter {
-    /// Starts a text file at `path`.
-    pub fn new(path: &Path) -> Result<Self> {
-        let mut file = AtomicFile::create(path)?;
+    /// Starts a text file in `out`.
+    fn new(out: Output) -> Result<Self> {
+        let mut file = out.buffered();
         file.write_all(b"# t_us x y p\n")?;
         Ok(TextWriter {
             file,
@@ -204,7 +231,7 @@ trait WordEncoder {
 const DIRECT_TIME_LIMIT: i64 = 1 << 24;
 
 struct WordWriter<E: WordEncoder> {
-    file: AtomicFile,
+    file: Buffered,
     enc: E,
     width: u16,
     height: u16,
@@ -215,9 +242,9 @@ struct WordWriter<E: WordEncoder> {
 }
 
 impl<E: WordEncoder> WordWriter<E> {
-    fn new(path: &Path, width: u16, height: u16, enc: E) -> Result<Self> {
-        Ok(WordWriter {
-            file: AtomicFile::create(path)?,
+    fn new(out: Output, width: u16, height: u16, enc: E) -> Self {
+        WordWriter {
+            file: out.buffered(),
             enc,
             width,
             height,
@@ -225,7 +252,7 @@ impl<E: WordEncoder> WordWriter<E> {
             buf: Vec::new(),
             rel: Vec::new(),
             count: 0,
-        })
+        }
     }
 
     fn start(&mut self, first_t: i64) -> Result<()> {

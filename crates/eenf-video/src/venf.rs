@@ -9,7 +9,7 @@ use crate::source::{FrameSource, VideoInfo};
 use crate::VideoError;
 
 /// How scene content is taken out before the flicker is tracked.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum SceneRemoval {
     /// The paper's: each frame minus the mean of it and the next one.
     Paper,
@@ -20,19 +20,58 @@ pub enum SceneRemoval {
 }
 
 impl SceneRemoval {
-    /// Parses `paper`, `row-mean` or `none`.
-    pub fn parse(s: &str) -> Option<Self> {
+    /// Every variant, by its command-line name.
+    pub const NAMES: [&'static str; 3] = ["paper", "row-mean", "none"];
+}
+
+impl std::fmt::Display for SceneRemoval {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(Self::NAMES[*self as usize])
+    }
+}
+
+impl std::str::FromStr for SceneRemoval {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
         match s {
-            "paper" => Some(SceneRemoval::Paper),
-            "row-mean" => Some(SceneRemoval::RowMean),
-            "none" => Some(SceneRemoval::None),
-            _ => None,
+            "paper" => Ok(SceneRemoval::Paper),
+            "row-mean" => Ok(SceneRemoval::RowMean),
+            "none" => Ok(SceneRemoval::None),
+            _ => Err(format!("{s:?}: expected paper, row-mean or none")),
+        }
+    }
+}
+
+impl RowSampling {
+    /// Every variant, by its command-line name.
+    pub const NAMES: [&'static str; 3] = ["zero-pad", "naive", "global"];
+}
+
+impl std::fmt::Display for RowSampling {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            RowSampling::ZeroPad(_) => "zero-pad",
+            RowSampling::Naive => "naive",
+            RowSampling::Global => "global",
+        })
+    }
+}
+
+/// `zero-pad` estimates its idle rows ([`IdleRows::Auto`]).
+impl std::str::FromStr for RowSampling {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "zero-pad" => Ok(RowSampling::ZeroPad(IdleRows::Auto)),
+            "naive" => Ok(RowSampling::Naive),
+            "global" => Ok(RowSampling::Global),
+            _ => Err(format!("{s:?}: expected zero-pad, naive or global")),
         }
     }
 }
 
 /// How rows become a uniformly sampled signal.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum RowSampling {
     /// Rows concatenated frame after frame at rows·fps, the idle gap ignored.
     Naive,
@@ -43,7 +82,7 @@ pub enum RowSampling {
 }
 
 /// How many virtual rows (real plus idle) one frame period holds.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum IdleRows {
     /// Estimated from the flicker's ripple within frames.
     Auto,
@@ -156,7 +195,7 @@ impl RowMeans {
 
 /// An ENF trace from a video and how it was made.
 #[derive(Debug, Clone, serde::Serialize)]
-pub struct VideoTrace {
+pub struct VideoAnalysis {
     /// Seconds between estimates; estimate i is centred at i·step_s from the first frame.
     pub step_s: f64,
     /// The ENF, Hz.
@@ -253,7 +292,7 @@ fn sample(rows: &RowMeans, sampling: RowSampling, virtual_rows: Option<f64>) -> 
 }
 
 /// V-ENF on row means already read (see [`RowMeans::read`]).
-pub fn video_enf_from_rows(raw: &RowMeans, opts: &VideoOptions) -> Result<VideoTrace, VideoError> {
+pub fn video_enf_from_rows(raw: &RowMeans, opts: &VideoOptions) -> Result<VideoAnalysis, VideoError> {
     let info = raw.info;
     let p = &opts.params;
     let duration = raw.frames() as f64 / info.fps;
@@ -332,7 +371,7 @@ pub fn video_enf_from_rows(raw: &RowMeans, opts: &VideoOptions) -> Result<VideoT
     } else {
         on_2f
     };
-    Ok(VideoTrace {
+    Ok(VideoAnalysis {
         step_s: p.step_s,
         enf_hz: corrected.iter().map(|f| f / 2.0).collect(),
         nominal_hz: nominal,
@@ -351,7 +390,7 @@ pub fn video_enf(
     source: &mut FrameSource,
     opts: &VideoOptions,
     progress: impl FnMut(u64),
-) -> Result<VideoTrace, VideoError> {
+) -> Result<VideoAnalysis, VideoError> {
     let rows = RowMeans::read(source, progress)?;
     if rows.frames() == 0 {
         return Err(VideoError::Signal("the video holds no frame".into()));

@@ -1,148 +1,66 @@
-//! The EV-ENFD naming: recordings `dvSave-YYYY_MM_DD_HH_MM_SS.*` (local start time) and hourly
-//! references `YYYY_MM_DD_Day_HH_00_00.wav`.
+//! The EV-ENFD layout: recordings `dvSave-YYYY_MM_DD_HH_MM_SS.*` (local start time), hourly
+//! references `YYYY_MM_DD_Day_HH_00_00.wav`, and the plan of a simulated dataset (classes,
+//! scenes, lamps and start times of its recordings).
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+use eenf_sim::{Lamp, LampKind, Readout, SceneKind, SimConfig};
+use rand::{Rng, SeedableRng};
 
-/// A local wall-clock start time taken from a file name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub struct StartTime {
-    /// Year.
-    pub year: u32,
-    /// Month 1–12.
-    pub month: u32,
-    /// Day 1–31.
-    pub day: u32,
-    /// Hour 0–23.
-    pub hour: u32,
-    /// Minute.
-    pub minute: u32,
-    /// Second.
-    pub second: u32,
+use crate::time::LocalTime;
+
+/// The dataset's recording name, `dvSave-YYYY_MM_DD_HH_MM_SS.<ext>`.
+pub fn recording_name(t: &LocalTime, ext: &str) -> String {
+    format!(
+        "dvSave-{}_{:02}_{:02}_{:02}.{ext}",
+        t.date(),
+        t.hour(),
+        t.minute(),
+        t.second()
+    )
 }
 
-impl StartTime {
-    /// Seconds into the hour.
-    pub fn second_of_hour(&self) -> u32 {
-        self.minute * 60 + self.second
-    }
-
-    /// The date prefix `YYYY_MM_DD`.
-    pub fn date(&self) -> String {
-        format!("{:04}_{:02}_{:02}", self.year, self.month, self.day)
-    }
-
-    /// The wall-clock time `seconds` after 1970-01-01 00:00 (local time, no zone).
-    pub fn from_local_seconds(seconds: i64) -> Self {
-        let days = seconds.div_euclid(86_400);
-        let sod = seconds.rem_euclid(86_400) as u32;
-        // civil from days (Howard Hinnant's algorithm)
-        let z = days + 719_468;
-        let era = z.div_euclid(146_097);
-        let doe = z - era * 146_097;
-        let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-        let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-        let mp = (5 * doy + 2) / 153;
-        let day = (doy - (153 * mp + 2) / 5 + 1) as u32;
-        let month = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
-        let year = (yoe + era * 400 + i64::from(month <= 2)) as u32;
-        StartTime {
-            year,
-            month,
-            day,
-            hour: sod / 3600,
-            minute: sod / 60 % 60,
-            second: sod % 60,
-        }
-    }
-
-    /// Seconds after 1970-01-01 00:00 of this wall-clock time.
-    pub fn local_seconds(&self) -> i64 {
-        crate::pipeline::days_from_civil(self.year as i64, self.month, self.day) * 86_400
-            + (self.hour * 3600 + self.minute * 60 + self.second) as i64
-    }
-
-    /// `Mon`…`Sun`.
-    pub fn weekday(&self) -> &'static str {
-        let days = crate::pipeline::days_from_civil(self.year as i64, self.month, self.day);
-        // 1970-01-01 was a Thursday
-        ["Thu", "Fri", "Sat", "Sun", "Mon", "Tue", "Wed"][days.rem_euclid(7) as usize]
-    }
-
-    /// The dataset's recording name, `dvSave-YYYY_MM_DD_HH_MM_SS.<ext>`.
-    pub fn recording_name(&self, ext: &str) -> String {
-        format!(
-            "dvSave-{}_{:02}_{:02}_{:02}.{ext}",
-            self.date(),
-            self.hour,
-            self.minute,
-            self.second
-        )
-    }
-
-    /// The dataset's name of the hourly reference holding this time,
-    /// `YYYY_MM_DD_Day_HH_00_00.wav`.
-    pub fn reference_name(&self) -> String {
-        format!(
-            "{}_{}_{:02}_00_00.wav",
-            self.date(),
-            self.weekday(),
-            self.hour
-        )
-    }
+/// The dataset's name of the hourly reference holding `t`, `YYYY_MM_DD_Day_HH_00_00.wav`.
+pub fn reference_name(t: &LocalTime) -> String {
+    format!("{}_{}_{:02}_00_00.wav", t.date(), t.weekday(), t.hour())
 }
 
 /// Finds `dvSave-YYYY_MM_DD_HH_MM_SS` in a path's file name.
-pub fn recording_start(path: &Path) -> Option<StartTime> {
+pub fn recording_start(path: &Path) -> Option<LocalTime> {
     let name = path.file_name()?.to_str()?;
     let i = name.find("dvSave-")?;
-    let digits: Vec<u32> = name[i + 7..]
+    let d: Vec<i16> = name[i + 7..]
         .split(['_', '.', '-'])
         .take(6)
         .map(|s| s.parse().ok())
-        .collect::<Option<Vec<u32>>>()?;
-    if digits.len() < 6 {
+        .collect::<Option<Vec<i16>>>()?;
+    if d.len() < 6 || d[1..].iter().any(|&v| !(0..=99).contains(&v)) {
         return None;
     }
-    let t = StartTime {
-        year: digits[0],
-        month: digits[1],
-        day: digits[2],
-        hour: digits[3],
-        minute: digits[4],
-        second: digits[5],
-    };
-    (t.month >= 1
-        && t.month <= 12
-        && t.day >= 1
-        && t.day <= 31
-        && t.hour < 24
-        && t.minute < 60
-        && t.second < 60)
-        .then_some(t)
+    LocalTime::new(d[0], d[1] as i8, d[2] as i8, d[3] as i8, d[4] as i8, d[5] as i8)
 }
 
 /// The start time of an hourly reference named `YYYY_MM_DD_Day_HH_00_00.wav`.
-pub fn reference_hour(path: &Path) -> Option<StartTime> {
+pub fn reference_hour(path: &Path) -> Option<LocalTime> {
     let stem = path.file_stem()?.to_str()?;
     let parts: Vec<&str> = stem.split('_').collect();
     if parts.len() != 7 {
         return None;
     }
-    let n = |s: &str| s.parse::<u32>().ok();
-    Some(StartTime {
-        year: n(parts[0])?,
-        month: n(parts[1])?,
-        day: n(parts[2])?,
-        hour: n(parts[4])?,
-        minute: n(parts[5])?,
-        second: n(parts[6])?,
-    })
+    let n = |s: &str| s.parse::<i8>().ok();
+    LocalTime::new(
+        parts[0].parse().ok()?,
+        n(parts[1])?,
+        n(parts[2])?,
+        n(parts[4])?,
+        n(parts[5])?,
+        n(parts[6])?,
+    )
 }
 
 /// The hourly reference WAVs of a folder, sorted by time.
-pub fn hourly_references(dir: &Path) -> Result<Vec<(StartTime, PathBuf)>> {
+pub fn hourly_references(dir: &Path) -> Result<Vec<(LocalTime, PathBuf)>> {
     let mut out = Vec::new();
     for entry in std::fs::read_dir(dir).with_context(|| format!("{}", dir.display()))? {
         let p = entry?.path();
@@ -167,6 +85,176 @@ pub fn hourly_references(dir: &Path) -> Result<Vec<(StartTime, PathBuf)>> {
     Ok(out)
 }
 
+/// One recording of a simulated dataset.
+#[derive(Debug, Clone)]
+pub struct PlannedRecording {
+    /// Its class folder: `static`, `dynamic` or `extreme`.
+    pub class: &'static str,
+    /// Its scene kinds.
+    pub kinds: Vec<SceneKind>,
+    /// Local start time, seconds since 1970-01-01 00:00 local.
+    pub local_start: i64,
+    /// The simulation.
+    pub config: SimConfig,
+}
+
+/// What a simulated dataset is made of.
+#[derive(Debug, Clone)]
+pub struct DatasetSpec {
+    /// `ev-enfd` (51 recordings of 180 s) or `small` (9 of 120 s).
+    pub preset: String,
+    /// Recording length, s (default: the preset's).
+    pub duration_s: Option<f64>,
+    /// Sensor resolution (default: the preset's).
+    pub resolution: Option<(u16, u16)>,
+    /// Sensor readout.
+    pub readout: Readout,
+    /// UTC offset of the recordings' local names, s.
+    pub tz_s: f64,
+    /// Seed of the whole dataset.
+    pub seed: u64,
+}
+
+/// A random lamp set: one to three lamps of the three kinds, on the phases of a three-phase
+/// supply when there are several.
+fn random_lamps(rng: &mut rand::rngs::StdRng) -> Vec<Lamp> {
+    let count = match rng.gen_range(0..10) {
+        0..=5 => 1,
+        6..=8 => 2,
+        _ => 3,
+    };
+    let phases = [0.0, 120.0, 240.0];
+    let offset = rng.gen_range(0..3);
+    (0..count)
+        .map(|k| {
+            let kind = match rng.gen_range(0..10) {
+                0..=5 => LampKind::Led {
+                    depth: rng.gen_range(0.35..0.6),
+                    sharpness: [1.0, 1.0, 2.0][rng.gen_range(0..3)],
+                    smoothing_ms: rng.gen_range(0.1..0.6),
+                },
+                6..=8 => LampKind::Incandescent {
+                    tau_ms: rng.gen_range(8.0..20.0),
+                },
+                _ => LampKind::Fluorescent {
+                    lag_rad: rng.gen_range(0.2..0.5),
+                    dead: rng.gen_range(0.08..0.2),
+                    phosphor_ms: rng.gen_range(0.8..2.5),
+                },
+            };
+            Lamp {
+                kind,
+                phase_deg: if count > 1 {
+                    phases[(offset + k) % 3]
+                } else {
+                    0.0
+                },
+                share: rng.gen_range(0.5..1.5),
+            }
+        })
+        .collect()
+}
+
+/// Recordings of a preset: (class, scene kinds) each.
+type Classes = Vec<(&'static str, Vec<SceneKind>)>;
+
+/// The classes and scene kinds of a preset, and its recording length and resolution.
+fn preset(name: &str) -> Result<(Classes, f64, (u16, u16))> {
+    use SceneKind::*;
+    let cycle = |class: &'static str, n: usize, kinds: &[&[SceneKind]]| {
+        (0..n)
+            .map(|i| (class, kinds[i % kinds.len()].to_vec()))
+            .collect::<Vec<_>>()
+    };
+    let dynamic: &[&[SceneKind]] = &[
+        &[DynamicObject],
+        &[DynamicCamera],
+        &[DynamicObject, DynamicCamera],
+    ];
+    let extreme: &[&[SceneKind]] = &[&[ExtremeDim], &[ExtremeBright]];
+    let (n, duration) = match name {
+        "ev-enfd" => ([16, 25, 10], 180.0),
+        "small" => ([3, 3, 3], 120.0),
+        other => bail!("--preset {other:?}: expected ev-enfd or small"),
+    };
+    let mut plans = cycle("static", n[0], &[&[Static]]);
+    plans.extend(cycle("dynamic", n[1], dynamic));
+    plans.extend(cycle("extreme", n[2], extreme));
+    Ok((plans, duration, (48, 36)))
+}
+
+/// The recordings of a dataset whose ENF covers local times `from..to`: start times spread
+/// over the coverage (distinct whole seconds, 30 s from its ends; one may run across an hour,
+/// the references continue in the next file), lamps, light and sensor biases drawn from
+/// the seed.
+pub fn plan_dataset(spec: &DatasetSpec, (from, to): (f64, f64)) -> Result<(Vec<PlannedRecording>, f64)> {
+    let (classes, preset_duration, preset_res) = preset(&spec.preset)?;
+    let duration = spec.duration_s.unwrap_or(preset_duration);
+    if !(20.0..=3600.0).contains(&duration) {
+        bail!("--duration must be between 20 and 3600 s");
+    }
+    let (width, height) = spec.resolution.unwrap_or(preset_res);
+    let (lo, hi) = (from.ceil() as i64 + 30, (to - duration).floor() as i64 - 30);
+    if hi <= lo + classes.len() as i64 {
+        bail!(
+            "the ENF covers {:.0} s, too little for {} recordings of {duration} s",
+            to - from,
+            classes.len()
+        );
+    }
+    let mut rng = rand::rngs::StdRng::seed_from_u64(spec.seed);
+    let mut starts: Vec<i64> = Vec::new();
+    while starts.len() < classes.len() {
+        let s = rng.gen_range(lo..hi);
+        if starts.iter().all(|&t| (t - s).abs() > 5) {
+            starts.push(s);
+        }
+    }
+    let plans = classes
+        .into_iter()
+        .zip(starts)
+        .enumerate()
+        .map(|(i, ((class, kinds), local_start))| {
+            let seed = spec.seed.wrapping_mul(1000).wrapping_add(i as u64);
+            let mut r = rand::rngs::StdRng::seed_from_u64(seed ^ 0x1a4b);
+            let mut config = SimConfig {
+                width,
+                height,
+                duration_s: duration,
+                start_us: ((local_start as f64 - spec.tz_s) * 1e6) as i64,
+                seed,
+                lamps: random_lamps(&mut r),
+                ambient: r.gen_range(0.05..0.35),
+                illumination: r.gen_range(0.5..2.0),
+                readout: spec.readout.clone(),
+                ..SimConfig::default()
+            }
+            .with_kinds(&kinds);
+            // a little variety in the sensor's bias settings
+            config.pixel.threshold = r.gen_range(0.17..0.25);
+            if kinds.contains(&SceneKind::ExtremeDim) {
+                // night scenes from ~1 to ~6 lux on a white wall
+                config.illumination = r.gen_range(0.004..0.02);
+            }
+            PlannedRecording {
+                class,
+                kinds,
+                local_start,
+                config,
+            }
+        })
+        .collect();
+    Ok((plans, duration))
+}
+
+/// `path` relative to `base` (with `/`), for the manifest.
+pub fn relative(base: &Path, path: &Path) -> String {
+    path.strip_prefix(base)
+        .unwrap_or(path)
+        .to_string_lossy()
+        .replace('\\', "/")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -174,26 +262,18 @@ mod tests {
     #[test]
     fn parses_dataset_names() {
         let t = recording_start(Path::new("static/dvSave-2022_08_17_16_54_30.aedat4")).unwrap();
-        assert_eq!((t.hour, t.second_of_hour()), (16, 54 * 60 + 30));
+        assert_eq!((t.hour(), t.second_of_hour()), (16, 54 * 60 + 30));
         assert_eq!(t.date(), "2022_08_17");
         assert!(recording_start(Path::new("dvSave-2022_13_17_16_54_30.aedat4")).is_none());
         let r = reference_hour(Path::new("x/2022_08_17_Wed_17_00_00.wav")).unwrap();
-        assert_eq!((r.day, r.hour, r.minute), (17, 17, 0));
+        assert_eq!((r.day(), r.hour(), r.minute()), (17, 17, 0));
         assert!(reference_hour(Path::new("notes.wav")).is_none());
         // names made from times read back as those times
-        let t = StartTime::from_local_seconds(r.local_seconds() + 754);
+        let t = LocalTime::from_local_seconds(r.local_seconds() + 754);
         assert_eq!(
-            t.recording_name("aedat4"),
+            recording_name(&t, "aedat4"),
             "dvSave-2022_08_17_17_12_34.aedat4"
         );
-        assert_eq!(t.reference_name(), "2022_08_17_Wed_17_00_00.wav");
-        let leap = StartTime::from_local_seconds(
-            crate::pipeline::days_from_civil(2024, 2, 29) * 86_400 + 3661,
-        );
-        assert_eq!(
-            (leap.month, leap.day, leap.hour, leap.minute),
-            (2, 29, 1, 1)
-        );
-        assert_eq!(leap.weekday(), "Thu");
+        assert_eq!(reference_name(&t), "2022_08_17_Wed_17_00_00.wav");
     }
 }

@@ -7,9 +7,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use eenf_dsp::{agreement, Agreement, EnfParams};
 
-use crate::dataset::{recording_start, reference_hour, StartTime};
-use crate::output::{read_trace, times};
-use crate::pipeline::{align, reference_file, reference_for_recording, Nominal};
+use crate::dataset::{recording_start, reference_hour};
+use crate::extract::Nominal;
+use crate::reference::{reference_file, reference_for_recording};
+use crate::time::LocalTime;
+use crate::trace::Trace;
 use crate::wav::is_wav;
 
 /// Where a recording's reference ENF comes from.
@@ -21,7 +23,7 @@ pub enum Reference {
         /// The folder.
         dir: PathBuf,
         /// When the recording started.
-        start: StartTime,
+        start: LocalTime,
     },
     /// One mains WAV, traced whole; the estimate's time 0 is at `offset_s` into it.
     Wav(PathBuf),
@@ -60,7 +62,7 @@ impl Reference {
                     .parent()
                     .filter(|d| !d.as_os_str().is_empty())
                     .unwrap_or(Path::new("."));
-                let start = StartTime::from_local_seconds(hour.local_seconds() + offset_s as i64);
+                let start = LocalTime::from_local_seconds(hour.local_seconds() + offset_s as i64);
                 Ok((
                     Reference::Hourly {
                         dir: dir.to_path_buf(),
@@ -101,25 +103,21 @@ pub fn compare(
     nominal: Nominal,
     params: &EnfParams,
 ) -> Result<Comparison> {
-    let (ref_t, ref_v, nominal_hz) = match reference {
+    let r = match reference {
         Reference::Hourly { dir, start } => {
             let step = params.step_s;
             let last = time_s.iter().copied().fold(0.0, f64::max);
             let seconds = ((last + offset_s) / step).floor().max(0.0) as usize + 1;
-            let (f0, trace) = reference_for_recording(dir, *start, seconds, nominal, params)?;
-            (times(trace.len(), step), trace, Some(f0))
+            reference_for_recording(dir, *start, seconds, nominal, params)?
         }
-        Reference::Wav(path) => {
-            let (f0, trace) = reference_file(path, nominal, params)?;
-            (times(trace.len(), params.step_s), trace, Some(f0))
-        }
-        Reference::Trace(path) => {
-            let r = read_trace(path)?;
-            (r.time_s, r.enf_hz, None)
-        }
+        Reference::Wav(path) => reference_file(path, nominal, params)?,
+        Reference::Trace(path) => Trace {
+            nominal_hz: None,
+            ..Trace::read(path, None)?
+        },
     };
-    let (t, e, r) = align(time_s, enf_hz, &ref_t, &ref_v, offset_s);
-    let Some(agreement) = agreement(&e, &r) else {
+    let (t, e, ref_v) = align(time_s, enf_hz, &r.time_s, &r.enf_hz, offset_s);
+    let Some(agreement) = agreement(&e, &ref_v) else {
         bail!(
             "{} and its reference share fewer than two seconds at offset {offset_s} s",
             what.display()
@@ -129,7 +127,88 @@ pub fn compare(
         agreement,
         time_s: t,
         estimate: e,
-        reference: r,
-        nominal_hz,
+        reference: ref_v,
+        nominal_hz: r.nominal_hz,
     })
+}
+
+/// Compares `estimate` (read from `estimate_path`) with the reference at `reference`: a trace,
+/// a mains WAV, or a folder of hourly WAVs, where the recording's `dvSave-` name (from the
+/// trace's metadata, else the trace file's own name) places it.
+pub fn compare_trace(
+    estimate: &Trace,
+    estimate_path: &Path,
+    reference: &Path,
+    offset_s: f64,
+    nominal: Nominal,
+    params: &EnfParams,
+) -> Result<Comparison> {
+    let source = estimate
+        .file
+        .clone()
+        .unwrap_or_else(|| estimate_path.to_path_buf());
+    let named = if recording_start(&source).is_some() {
+        source
+    } else {
+        estimate_path.to_path_buf()
+    };
+    let (reference, offset) = Reference::resolve(reference, &named, offset_s)?;
+    compare(
+        &estimate.time_s,
+        &estimate.enf_hz,
+        estimate_path,
+        &reference,
+        offset,
+        nominal,
+        params,
+    )
+}
+
+
+/// Pairs of (time, estimate, reference) where the reference holds a value at estimate time +
+/// `offset_s` (times matched to the millisecond).
+pub fn align(
+    est_t: &[f64],
+    est: &[f64],
+    ref_t: &[f64],
+    reference: &[f64],
+    offset_s: f64,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let key = |t: f64| (t * 1000.0).round() as i64;
+    let map: std::collections::HashMap<i64, f64> = ref_t
+        .iter()
+        .zip(reference)
+        .map(|(t, v)| (key(*t), *v))
+        .collect();
+    let mut out = (Vec::new(), Vec::new(), Vec::new());
+    for (t, e) in est_t.iter().zip(est) {
+        if let Some(r) = map.get(&key(t + offset_s)) {
+            if e.is_finite() && r.is_finite() {
+                out.0.push(*t);
+                out.1.push(*e);
+                out.2.push(*r);
+            }
+        }
+    }
+    out
+}
+
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn align_matches_times_with_offset() {
+        let (t, e, r) = align(
+            &[0.0, 1.0, 2.0],
+            &[1.0, 2.0, 3.0],
+            &[10.0, 11.0, 12.0, 13.0],
+            &[5.0, 6.0, 7.0, 8.0],
+            11.0,
+        );
+        assert_eq!(t, vec![0.0, 1.0, 2.0]);
+        assert_eq!(e, vec![1.0, 2.0, 3.0]);
+        assert_eq!(r, vec![6.0, 7.0, 8.0]);
+    }
 }

@@ -1,19 +1,29 @@
-//! # eenf (library part of the command-line tool)
+//! # eenf
 //!
-//! The commands of `eenf` are thin wrappers over these functions, which tests and benchmarks
-//! call directly: [`pipeline::extract_file`] (event file → ENF trace),
-//! [`pipeline::reference_file`] (mains WAV → reference trace),
-//! [`pipeline::reference_for_recording`] (a dataset's hourly references → the reference of one
-//! recording), [`pipeline::align`], [`evaluate::compare`] (a trace against its reference) and
-//! [`bench`] (a whole dataset, every method).
+//! The library behind the `eenf` command: every command is a thin layer over these modules,
+//! which tests, benchmarks and (later) the Python package call directly. The data path:
+//!
+//! - [`extract`]: an event recording → its polarity sequence → a [`trace::Trace`] (E-ENF);
+//!   [`video`]: a video → a `Trace` (V-ENF); [`reference`]: a mains recording → a `Trace`.
+//! - [`evaluate`]: a `Trace` against its reference → an `Agreement` (CC, MAE, RMSE, max).
+//! - [`refdb`] and [`reference::ReferenceSeries`]: long references that `match` searches.
+//! - [`bench`]: every method over a dataset, Table 2 and figures; [`simulation`] and
+//!   [`dataset`]: simulated recordings and datasets with their truth.
+//!
+//! [`trace`] reads and writes traces, [`output`] writes every file whole or not at all,
+//! [`time`] holds all calendar and time-zone work.
 
 pub mod bench;
 pub mod dataset;
 pub mod evaluate;
+pub mod extract;
 pub mod output;
-pub mod pipeline;
 pub mod plot;
 pub mod progress;
 pub mod refdb;
+pub mod reference;
 pub mod simulation;
+pub mod time;
+pub mod trace;
+pub mod video;
 pub mod wav;

@@ -54,7 +54,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let progress = eenf_cli::progress::Progress::new(cli.quiet);
+    let progress = eenf::progress::Progress::new(cli.quiet);
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),
         Command::Convert(a) => commands::convert::run(a, progress),
@@ -64,7 +64,7 @@ fn main() -> ExitCode {
         Command::Refdb(c) => commands::refdb::run(c, progress),
         Command::Match(a) => commands::matching::run(a, progress),
         Command::Video(a) => commands::video::run(a, progress),
-        Command::Simulate(a) => commands::simulate::run(a, progress).map(|_| ()),
+        Command::Simulate(a) => commands::simulate::run(a, progress),
         Command::SimulateDataset(a) => commands::simulate_dataset::run(a, progress),
         Command::Bench(a) => commands::bench::run(a, progress),
         Command::Demo(a) => commands::demo::run(a, progress),

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use anyhow::{anyhow, bail, Context, Result};
-use eenf_dsp::EnfTrace;
+use anyhow::{anyhow, bail, Result};
+use crate::trace::Trace;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -34,14 +34,11 @@ fn render(
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
-    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("plot");
-    // the backend picks the image format from the extension, so the temporary name keeps it
-    let tmp_name = format!(".{stem}.{}.tmp.{ext}", std::process::id());
-    let tmp = if eenf_events::is_special_file(path) {
-        std::env::temp_dir().join(tmp_name)
-    } else {
-        path.with_file_name(tmp_name)
-    };
+    if !matches!(ext.as_str(), "png" | "svg") {
+        bail!("{}: plots are written as .png or .svg", path.display());
+    }
+    let out = crate::output::AtomicFile::keeping_extension(path)?;
+    let tmp = out.path().to_path_buf();
     let res = match ext.as_str() {
         "png" => {
             let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
@@ -54,13 +51,8 @@ fn render(
         _ => bail!("{}: plots are written as .png or .svg", path.display()),
     };
     match res {
-        Ok(()) => {
-            eenf_events::commit_tmp(&tmp, path).with_context(|| format!("{}", path.display()))
-        }
-        Err(err) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(err.context(format!("{}: cannot draw the plot", path.display())))
-        }
+        Ok(()) => out.commit(),
+        Err(err) => Err(err.context(format!("{}: cannot draw the plot", path.display()))),
     }
 }
 
@@ -558,20 +550,20 @@ pub fn plot_summary(
 fn extraction<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
-    tr: &EnfTrace,
+    tr: &Trace,
 ) -> Result<()> {
     root.fill(&WHITE).map_err(e)?;
     let root = root.titled(title, ("sans-serif", 22)).map_err(e)?;
     let (upper, lower) = root.split_vertically(SIZE.1 as i32 * 68 / 100);
     let n = tr.enf_hz.len();
-    let t: Vec<f64> = (0..n).map(|i| i as f64 * tr.step_s).collect();
+    let t = &tr.time_s;
     let x = (0.0, (n.max(2) - 1) as f64 * tr.step_s);
     let y = range(tr.harmonics.iter().flat_map(|h| h.enf_hz.iter().copied()));
     let mut c = enf_panel(&upper, x, y)?;
     for (k, h) in tr.harmonics.iter().enumerate() {
         let col = PALETTE[k % PALETTE.len()];
         c.draw_series(LineSeries::new(
-            finite_points(&t, &h.enf_hz),
+            finite_points(t, &h.enf_hz),
             col.stroke_width(1),
         ))
         .map_err(e)?
@@ -579,7 +571,7 @@ fn extraction<DB: DrawingBackend>(
         .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col.stroke_width(2)));
     }
     c.draw_series(LineSeries::new(
-        finite_points(&t, &tr.enf_hz),
+        finite_points(t, &tr.enf_hz),
         BLACK.stroke_width(3),
     ))
     .map_err(e)?
@@ -600,8 +592,9 @@ fn extraction<DB: DrawingBackend>(
         .y_label_formatter(&|v| format!("{v:.0}"))
         .draw()
         .map_err(e)?;
-    let seg = tr.segment_len as f64 * tr.step_s;
-    c.draw_series(tr.selected.iter().enumerate().map(|(i, &m)| {
+    let seg = tr.segment_s().unwrap_or(x.1);
+    c.draw_series(tr.selected.iter().map(|s| {
+        let m = s.harmonic;
         let col = tr
             .harmonics
             .iter()
@@ -610,8 +603,8 @@ fn extraction<DB: DrawingBackend>(
             .unwrap_or(BLACK);
         Rectangle::new(
             [
-                (i as f64 * seg, m as f64 - 0.35),
-                (((i + 1) as f64 * seg).min(x.1), m as f64 + 0.35),
+                (s.start_s, m as f64 - 0.35),
+                ((s.start_s + seg).min(x.1), m as f64 + 0.35),
             ],
             col.filled(),
         )
@@ -621,7 +614,7 @@ fn extraction<DB: DrawingBackend>(
 }
 
 /// Per-harmonic traces, the selected trace, and the harmonic chosen per segment.
-pub fn plot_extraction(path: &Path, title: &str, trace: &EnfTrace) -> Result<()> {
+pub fn plot_extraction(path: &Path, title: &str, trace: &Trace) -> Result<()> {
     render(
         path,
         |root| extraction(root, title, trace),

@@ -9,7 +9,6 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 
 use crate::output::write_atomic;
-use crate::pipeline::days_from_civil;
 
 /// The value that marks a missing second.
 pub const GAP: i32 = i32::MIN;
@@ -188,86 +187,9 @@ impl RefSeries {
     }
 }
 
-/// Parses `2022-08-01T00:00:00Z`, `2022-08-01 00:00:00+08:00` or a number of Unix seconds.
-pub fn parse_time(s: &str) -> Result<f64> {
-    if let Ok(v) = s.parse::<f64>() {
-        return Ok(v);
-    }
-    let bad = || {
-        anyhow::anyhow!(
-            "{s:?}: expected a time like 2022-08-17T16:10:00Z or 2022-08-17T16:10:00+08:00"
-        )
-    };
-    let s = s.trim();
-    let (date, rest) = s.split_at(s.find(['T', ' ']).ok_or_else(bad)?);
-    let rest = &rest[1..];
-    let d: Vec<i64> = date
-        .split('-')
-        .map(|p| p.parse().map_err(|_| bad()))
-        .collect::<Result<_>>()?;
-    if d.len() != 3 {
-        return Err(bad());
-    }
-    let (clock, tz) = match rest.find(['Z', '+', '-']) {
-        Some(i) => (&rest[..i], &rest[i..]),
-        None => (rest, "Z"),
-    };
-    let c: Vec<f64> = clock
-        .split(':')
-        .map(|p| p.parse().map_err(|_| bad()))
-        .collect::<Result<_>>()?;
-    if c.len() < 2 {
-        return Err(bad());
-    }
-    let offset = tz_offset(tz)?;
-    let days = days_from_civil(d[0], d[1] as u32, d[2] as u32);
-    Ok(
-        days as f64 * 86_400.0 + c[0] * 3600.0 + c[1] * 60.0 + c.get(2).copied().unwrap_or(0.0)
-            - offset,
-    )
-}
-
-/// `Z`, `+08:00`, `-0500` → seconds east of UTC.
-pub fn tz_offset(tz: &str) -> Result<f64> {
-    if tz.is_empty() || tz == "Z" || tz.eq_ignore_ascii_case("utc") {
-        return Ok(0.0);
-    }
-    let sign = match tz.as_bytes()[0] {
-        b'+' => 1.0,
-        b'-' => -1.0,
-        _ => bail!("{tz:?}: expected a UTC offset like +08:00"),
-    };
-    let digits: String = tz[1..].chars().filter(|c| c.is_ascii_digit()).collect();
-    let (h, m) = match digits.len() {
-        1 | 2 => (digits.parse::<f64>()?, 0.0),
-        4 => (digits[..2].parse::<f64>()?, digits[2..].parse::<f64>()?),
-        _ => bail!("{tz:?}: expected a UTC offset like +08:00"),
-    };
-    Ok(sign * (h * 3600.0 + m * 60.0))
-}
-
-/// Unix seconds as `2022-08-17T08:10:00Z`.
-pub fn utc(unix_s: f64) -> String {
-    let s = crate::output::utc_string((unix_s * 1e6).round() as i64);
-    // drop zero microseconds
-    s.replace(".000000Z", "Z")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn times_parse() {
-        assert_eq!(parse_time("1970-01-02T00:00:00Z").unwrap(), 86_400.0);
-        assert_eq!(
-            parse_time("2022-08-17T16:00:00+08:00").unwrap(),
-            parse_time("2022-08-17T08:00:00Z").unwrap()
-        );
-        assert_eq!(parse_time("12.5").unwrap(), 12.5);
-        assert!(parse_time("yesterday").is_err());
-        assert_eq!(utc(1_660_723_200.0), "2022-08-17T08:00:00Z");
-    }
 
     #[test]
     fn series_merge_round_trip() {

@@ -5,14 +5,17 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use eenf_events::writers::{create, OutputFormat};
-use eenf_sim::{simulate, MainsPhase, SimConfig, SimStats, SyntheticEnf};
+use eenf_events::writers::OutputFormat;
+use eenf_sim::{simulate, CameraConfig, MainsPhase, SimConfig, SimStats, SyntheticEnf};
 
-use crate::dataset::{hourly_references, StartTime};
-use crate::output::{read_series_csv, times, write_atomic, write_trace_csv};
-use crate::pipeline::{mains_nominal, Nominal};
+use crate::dataset::{hourly_references, reference_name};
+use crate::extract::Nominal;
+use crate::output::{sibling, write_atomic, write_events};
 use crate::progress::Progress;
-use crate::wav::{read_wav, write_wav};
+use crate::reference::mains_nominal;
+use crate::time::{offset_of, parse_time, LocalTime};
+use crate::trace::Trace;
+use crate::wav::{is_wav, read_wav, write_wav};
 
 /// Sampling rate of synthesized mains references (the dataset's).
 pub const REFERENCE_FS: u32 = 400;
@@ -59,7 +62,8 @@ impl EnfTimeline {
     /// A trace CSV (`time_s,enf_hz`, or `index,value` at `step_s`) whose first value is at
     /// local time `t0`.
     pub fn trace(path: &Path, step_s: f64, t0: f64) -> Result<Self> {
-        let (step_s, values) = read_series_csv(path, Some(step_s))?;
+        let series = Trace::read(path, Some(step_s))?;
+        let (step_s, values) = (series.step_s, series.enf_hz);
         if values.len() < 4 || values.iter().any(|v| !v.is_finite()) {
             bail!("{}: a trace needs at least 4 finite values", path.display());
         }
@@ -239,7 +243,7 @@ impl EnfTimeline {
                     );
                 }
                 while hour < to {
-                    let name = StartTime::from_local_seconds(hour as i64).reference_name();
+                    let name = reference_name(&LocalTime::from_local_seconds(hour as i64));
                     let path = dir.join(name);
                     let phase = self.phase(hour, 3600.0)?;
                     write_wav(
@@ -289,12 +293,6 @@ pub struct Simulated {
     pub seconds: f64,
 }
 
-/// NAME.ext → NAME.<suffix>
-pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
-    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
-    path.with_file_name(format!("{stem}.{suffix}"))
-}
-
 /// Simulates `config` under `mains` into `output` (format `format`), with the truth beside it
 /// as NAME.truth.csv and every parameter as NAME.sim.json. `extra` joins the sidecar.
 ///
@@ -326,18 +324,19 @@ pub fn write_recording(
     if let Some(parent) = output.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).with_context(|| format!("{}", parent.display()))?;
     }
-    let mut writer = create(output, format, config.width, config.height)?;
-    let stats = simulate(config, mains, |b| {
-        bar.inc(250);
-        writer.write(b).map_err(anyhow::Error::from)
+    let mut stats = None;
+    write_events(output, format, config.width, config.height, |writer| {
+        stats = Some(simulate(config, mains, |b| {
+            bar.inc(250);
+            writer.write(b).map_err(anyhow::Error::from)
+        })?);
+        Ok(())
     })?;
-    writer.finish()?;
+    let stats = stats.context("the simulation gave no statistics")?;
     bar.finish_and_clear();
-    let truth = mains.truth(config.duration_s);
+    let truth = Trace::new(1.0, mains.truth(config.duration_s));
     let truth_path = sibling(output, "truth.csv");
-    write_atomic(&truth_path, |w| {
-        write_trace_csv(w, &times(truth.len(), 1.0), &truth)
-    })?;
+    write_atomic(&truth_path, |w| truth.write_csv(w))?;
     let seconds = started.elapsed().as_secs_f64();
     let sidecar = serde_json::json!({
         "recording": output,
@@ -435,4 +434,157 @@ pub fn write_video(
         }
     }
     Ok(written)
+}
+
+/// Where a simulated recording's ENF comes from.
+#[derive(Debug, Clone)]
+pub enum EnfSource {
+    /// A synthetic grid of this nominal frequency (50 or 60 Hz).
+    Synthetic(f64),
+    /// A mains WAV or a trace CSV, from `offset_s` into it; an `index,value` CSV has values
+    /// `index_step_s` apart.
+    File {
+        /// The file.
+        path: PathBuf,
+        /// Seconds into it where the recording starts.
+        offset_s: f64,
+        /// Step of an `index,value` CSV.
+        index_step_s: f64,
+    },
+}
+
+/// Everything one simulated recording is made from.
+#[derive(Debug, Clone)]
+pub struct Recipe {
+    /// The scene, lamps and sensor (`start_us` is set from `start`).
+    pub config: SimConfig,
+    /// Where the ENF comes from.
+    pub enf: EnfSource,
+    /// Local start time with its UTC offset, e.g. `2022-08-17T16:10:00+08:00` (a source named
+    /// like the dataset's hourly references fixes the time instead).
+    pub start: String,
+    /// The recording.
+    pub output: PathBuf,
+    /// Its format.
+    pub format: OutputFormat,
+    /// Conventional cameras to render the same scene through.
+    pub cameras: Vec<CameraConfig>,
+    /// Also encode the videos as MP4.
+    pub mp4: bool,
+    /// Write the hourly mains references covering the recording here.
+    pub reference_dir: Option<PathBuf>,
+}
+
+/// The local start of a simulated recording unless told otherwise: 16:10 in Wuhan on the
+/// day of the shared references.
+pub const DEFAULT_START: &str = "2022-08-17T16:10:00+08:00";
+
+impl Recipe {
+    /// `config` on a synthetic 50 Hz grid from [`DEFAULT_START`], as LZ4 AEDAT4 to `output`.
+    pub fn new(config: SimConfig, output: PathBuf) -> Self {
+        Recipe {
+            config,
+            enf: EnfSource::Synthetic(50.0),
+            start: DEFAULT_START.to_string(),
+            output,
+            format: OutputFormat::Aedat4(eenf_events::Compression::Lz4),
+            cameras: Vec::new(),
+            mp4: false,
+            reference_dir: None,
+        }
+    }
+}
+
+/// A simulated recording and everything written with it.
+pub struct SimulatedRecording {
+    /// The recording, its truth and statistics.
+    pub sim: Simulated,
+    /// The simulation as run.
+    pub config: SimConfig,
+    /// Local start, seconds since 1970-01-01 00:00 local.
+    pub local_start: f64,
+    /// Videos written.
+    pub videos: Vec<PathBuf>,
+    /// Reference WAVs written.
+    pub references: Vec<PathBuf>,
+}
+
+/// The local start (seconds) and UTC offset of a recording starting at `start`, or
+/// `source_start` seconds into a source named like an hourly reference.
+fn local_start(start: &str, source: Option<&Path>, source_start: f64) -> Result<(f64, f64)> {
+    let tz = offset_of(start)?;
+    if let Some(t) = source.and_then(crate::dataset::reference_hour) {
+        return Ok((t.local_seconds() as f64 + source_start, tz));
+    }
+    let utc = parse_time(start).context("--start")?;
+    Ok((utc + tz, tz))
+}
+
+/// The ENF timeline of a recipe, and the recording's local start and UTC offset.
+pub fn recipe_timeline(r: &Recipe) -> Result<(EnfTimeline, f64, f64)> {
+    let duration = r.config.duration_s;
+    match &r.enf {
+        EnfSource::Synthetic(grid) => {
+            if *grid != 50.0 && *grid != 60.0 {
+                bail!("--grid must be 50 or 60");
+            }
+            let (start, tz) = local_start(&r.start, None, 0.0)?;
+            let seed = r.config.seed ^ 0x5eed;
+            let t = EnfTimeline::synthetic(*grid, start, start + duration, seed);
+            Ok((t, start, tz))
+        }
+        EnfSource::File {
+            path,
+            offset_s,
+            index_step_s,
+        } => {
+            if !path.exists() {
+                bail!("{}: no such file", path.display());
+            }
+            let (start, tz) = local_start(&r.start, Some(path), *offset_s)?;
+            let t0 = start - offset_s;
+            let t = if is_wav(path) {
+                EnfTimeline::wav(path, t0)?
+            } else {
+                EnfTimeline::trace(path, *index_step_s, t0)?
+            };
+            Ok((t, start, tz))
+        }
+    }
+}
+
+/// Simulates a recipe: the recording with its truth and sidecar, its videos and references.
+pub fn simulate_recording(r: &Recipe, progress: &Progress) -> Result<SimulatedRecording> {
+    let (timeline, start, tz) = recipe_timeline(r)?;
+    let config = SimConfig {
+        start_us: ((start - tz) * 1e6).round() as i64,
+        ..r.config.clone()
+    };
+    config.check().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mains = timeline.phase(start, config.duration_s)?;
+    let extra = serde_json::json!({
+        "enf": timeline.describe(),
+        "local_start": start,
+        "utc_offset_s": tz,
+    });
+    let sim = write_recording(&config, &mains, &r.output, r.format, extra, progress)?;
+    let mut videos = Vec::new();
+    for camera in &r.cameras {
+        videos.extend(write_video(
+            &config, camera, &mains, &r.output, r.mp4, progress,
+        )?);
+    }
+    let references = match &r.reference_dir {
+        Some(dir) => {
+            timeline.write_references(dir, start, start + config.duration_s, config.seed)?
+        }
+        None => Vec::new(),
+    };
+    Ok(SimulatedRecording {
+        sim,
+        config,
+        local_start: start,
+        videos,
+        references,
+    })
 }

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 
 /// Samples of a mono signal.
 pub struct Signal {
@@ -68,15 +68,15 @@ pub fn read_wav(path: &Path) -> Result<Signal> {
 
 /// Writes a mono 16-bit WAV (samples in ±1), whole or not at all.
 pub fn write_wav(path: &Path, fs: u32, samples: &[f64]) -> Result<()> {
-    let tmp = eenf_events::tmp_path_for(path);
     let spec = hound::WavSpec {
         channels: 1,
         sample_rate: fs,
         bits_per_sample: 16,
         sample_format: hound::SampleFormat::Int,
     };
+    let out = crate::output::AtomicFile::create(path)?;
     let res = (|| -> Result<()> {
-        let mut w = hound::WavWriter::create(&tmp, spec)?;
+        let mut w = hound::WavWriter::new(std::io::BufWriter::new(out.file()?), spec)?;
         for &s in samples {
             w.write_sample((s.clamp(-1.0, 1.0) * 32767.0).round() as i16)?;
         }
@@ -84,13 +84,8 @@ pub fn write_wav(path: &Path, fs: u32, samples: &[f64]) -> Result<()> {
         Ok(())
     })();
     match res {
-        Ok(()) => {
-            eenf_events::commit_tmp(&tmp, path).with_context(|| format!("{}", path.display()))
-        }
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e.context(format!("{}: cannot write WAV", path.display())))
-        }
+        Ok(()) => out.commit(),
+        Err(e) => Err(e.context(format!("{}: cannot write WAV", path.display()))),
     }
 }
 

@@ -107,13 +107,13 @@ fn hourly_references_align_by_name_across_the_hour() {
     let refs = d.join("ENF_Reference");
     std::fs::create_dir(&refs).unwrap();
     let hour = (3600.0 * fs) as usize;
-    eenf_cli::wav::write_wav(
+    eenf::wav::write_wav(
         &refs.join("2022_08_17_Wed_16_00_00.wav"),
         200,
         &volts[..hour],
     )
     .unwrap();
-    eenf_cli::wav::write_wav(
+    eenf::wav::write_wav(
         &refs.join("2022_08_17_Wed_17_00_00.wav"),
         200,
         &volts[hour..],
@@ -176,8 +176,8 @@ fn refdb_and_match_locate_a_clip() {
         .map(|i| 0.6 * mains.phase_at(i as f64 / fs).cos())
         .collect();
     let hour = (3600.0 * fs) as usize;
-    eenf_cli::wav::write_wav(&d.join("2022_08_17_Wed_16_00_00.wav"), 200, &volts[..hour]).unwrap();
-    eenf_cli::wav::write_wav(&d.join("2022_08_17_Wed_17_00_00.wav"), 200, &volts[hour..]).unwrap();
+    eenf::wav::write_wav(&d.join("2022_08_17_Wed_16_00_00.wav"), 200, &volts[..hour]).unwrap();
+    eenf::wav::write_wav(&d.join("2022_08_17_Wed_17_00_00.wav"), 200, &volts[hour..]).unwrap();
     eenf(
         &[
             "-q",

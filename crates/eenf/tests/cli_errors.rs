@@ -123,7 +123,7 @@ fn bad_inputs_give_one_line_errors() {
             (state.wrapping_mul(0x2545f4914f6cdd1d) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         })
         .collect();
-    eenf_cli::wav::write_wav(&d.join("noise.wav"), 400, &noise).unwrap();
+    eenf::wav::write_wav(&d.join("noise.wav"), 400, &noise).unwrap();
     fails(&["reference", "noise.wav"], d, "noise.wav", "no mains line");
     fails(
         &["reference", "--nominal", "50", "noise.wav"],
@@ -131,7 +131,7 @@ fn bad_inputs_give_one_line_errors() {
         "noise.wav",
         "no 50 Hz mains line",
     );
-    eenf_cli::wav::write_wav(&d.join("slow.wav"), 80, &noise[..2400]).unwrap();
+    eenf::wav::write_wav(&d.join("slow.wav"), 80, &noise[..2400]).unwrap();
     fails(&["reference", "slow.wav"], d, "slow.wav", "too low");
     std::fs::write(d.join("fake.wav"), b"RIFF\x10\x00\x00\x00WAVEjunk").unwrap();
     fails(&["reference", "fake.wav"], d, "fake.wav", "wav");

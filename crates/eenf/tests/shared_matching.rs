@@ -4,7 +4,8 @@
 
 use std::path::PathBuf;
 
-use eenf_cli::pipeline::{reference_file, Nominal};
+use eenf::extract::Nominal;
+use eenf::reference::reference_file;
 use eenf_dsp::matching::{match_trace, MatchOptions, DEFAULT_ALPHA};
 use eenf_dsp::EnfParams;
 
@@ -25,7 +26,9 @@ fn hours50() -> Vec<f64> {
     let wavs = common::reference_wavs();
     let mut all = Vec::new();
     for w in wavs {
-        let (_, t) = reference_file(&w, Nominal::Hz(50.0), &EnfParams::default()).unwrap();
+        let t = reference_file(&w, Nominal::Hz(50.0), &EnfParams::default())
+            .unwrap()
+            .enf_hz;
         all.extend_from_slice(&t[..3600]);
     }
     all
@@ -134,13 +137,13 @@ fn real_enf_clips_are_placed_and_outsiders_rejected() {
 #[test]
 #[ignore = "needs ../shared"]
 fn an_eenf_trace_from_a_simulated_recording_is_placed_at_its_time() {
-    use eenf_cli::pipeline::{extract_file, ExtractOptions};
-    use eenf_cli::progress::Progress;
+    use eenf::extract::{extract_file, ExtractOptions};
+    use eenf::progress::Progress;
     use eenf_events::{Aedat4Writer, Compression};
     use eenf_sim::{simulate, MainsPhase, SimConfig};
 
     let wav = shared().join("enf-reference/2022_08_17_Wed_17_00_00.wav");
-    let sig = eenf_cli::wav::read_wav(&wav).unwrap();
+    let sig = eenf::wav::read_wav(&wav).unwrap();
     let config = SimConfig {
         duration_s: 300.0,
         seed: 17,
@@ -155,7 +158,7 @@ fn an_eenf_trace_from_a_simulated_recording_is_placed_at_its_time() {
     let x = extract_file(&rec, &ExtractOptions::default(), &Progress::hidden()).unwrap();
     // the six hours from 16:00; the recording starts at 17:20:00, value 3600 + 1200
     let hours = hours50();
-    let res = match_trace(&x.trace.enf_hz, &hours[..], &MatchOptions::default()).unwrap();
+    let res = match_trace(&x.enf_hz, &hours[..], &MatchOptions::default()).unwrap();
     let top = res.candidates[0];
     println!("E-ENF clip: {top:?}");
     assert!((top.offset - 4800.0).abs() <= 1.0, "{top:?}");

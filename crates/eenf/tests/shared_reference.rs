@@ -3,7 +3,8 @@
 
 use std::path::PathBuf;
 
-use eenf_cli::pipeline::{reference_file, Nominal};
+use eenf::extract::Nominal;
+use eenf::reference::reference_file;
 use eenf_dsp::{EnfParams, PeakMethod};
 
 mod common;
@@ -35,7 +36,8 @@ fn six_real_hours_match_the_datasets_own_references() {
             peak: PeakMethod::Paper,
             ..EnfParams::default()
         };
-        let (f0, trace) = reference_file(wav, Nominal::Auto, &params).unwrap();
+        let r = reference_file(wav, Nominal::Auto, &params).unwrap();
+        let (f0, trace) = (r.nominal_hz.unwrap(), r.enf_hz);
         assert_eq!(f0, 50.0);
         assert!(
             trace.len() == 3601 || trace.len() == 3602,
@@ -68,7 +70,9 @@ fn six_real_hours_match_the_datasets_own_references() {
         assert!(share >= 0.995, "{}: only {share}", wav.display());
         // the exact refinement differs from the paper's by the interpolation bias: about a
         // millisecond-hertz on average, a few at worst where the ENF moves within the window
-        let (_, exact) = reference_file(wav, Nominal::Hz(50.0), &EnfParams::default()).unwrap();
+        let exact = reference_file(wav, Nominal::Hz(50.0), &EnfParams::default())
+            .unwrap()
+            .enf_hz;
         let diffs: Vec<f64> = exact
             .iter()
             .zip(&trace)
@@ -92,13 +96,13 @@ fn six_real_hours_match_the_datasets_own_references() {
 #[test]
 #[ignore = "needs ../shared"]
 fn simulation_driven_by_a_real_hour_is_recovered() {
-    use eenf_cli::pipeline::{extract_file, ExtractOptions};
-    use eenf_cli::progress::Progress;
+    use eenf::extract::{extract_file, ExtractOptions};
+    use eenf::progress::Progress;
     use eenf_events::{Aedat4Writer, Compression};
     use eenf_sim::{simulate, MainsPhase, SimConfig};
 
     let wav = shared().join("enf-reference/2022_08_17_Wed_16_00_00.wav");
-    let sig = eenf_cli::wav::read_wav(&wav).unwrap();
+    let sig = eenf::wav::read_wav(&wav).unwrap();
     let start = 600.0;
     let config = SimConfig {
         duration_s: 120.0,
@@ -112,15 +116,17 @@ fn simulation_driven_by_a_real_hour_is_recovered() {
     simulate(&config, &mains, |b| w.write(b)).unwrap();
     w.finish().unwrap();
     let x = extract_file(&rec, &ExtractOptions::default(), &Progress::hidden()).unwrap();
-    assert_eq!(x.params.nominal_hz, 50.0);
+    assert_eq!(x.nominal_hz, Some(50.0));
     // against the simulator's truth
     let truth = mains.truth(config.duration_s);
-    let m = eenf_dsp::agreement(&x.trace.enf_hz, &truth).unwrap();
+    let m = eenf_dsp::agreement(&x.enf_hz, &truth).unwrap();
     println!("vs truth: {m:?}");
     assert!(m.n >= 120 && m.cc >= 0.95 && m.mae_hz <= 0.002, "{m:?}");
     // and against the real hour's own reference trace, 600 s in
-    let (_, reference) = reference_file(&wav, Nominal::Hz(50.0), &EnfParams::default()).unwrap();
-    let m = eenf_dsp::agreement(&x.trace.enf_hz, &reference[600..]).unwrap();
+    let reference = reference_file(&wav, Nominal::Hz(50.0), &EnfParams::default())
+        .unwrap()
+        .enf_hz;
+    let m = eenf_dsp::agreement(&x.enf_hz, &reference[600..]).unwrap();
     println!("vs the WAV's reference at 600 s: {m:?}");
     assert!(m.cc >= 0.95 && m.mae_hz <= 0.002, "{m:?}");
 }

@@ -81,18 +81,25 @@ impl Compression {
         }
     }
 
-    /// Parses a name as printed by [`Compression::name`] (case-insensitive, `-` or `_`).
-    pub fn parse(s: &str) -> Option<Self> {
-        let s = s.to_ascii_uppercase().replace('-', "_");
-        [
-            Compression::None,
-            Compression::Lz4,
-            Compression::Lz4High,
-            Compression::Zstd,
-            Compression::ZstdHigh,
-        ]
-        .into_iter()
-        .find(|c| c.name() == s)
+    /// Every codec, by its command-line name.
+    pub const NAMES: [&'static str; 5] = ["none", "lz4", "lz4_high", "zstd", "zstd_high"];
+}
+
+impl std::fmt::Display for Compression {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A name as [`Compression::name`] prints it, case-insensitive, with `-` or `_`.
+impl std::str::FromStr for Compression {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        let upper = s.to_ascii_uppercase().replace('-', "_");
+        (0..5)
+            .filter_map(Compression::from_code)
+            .find(|c| c.name() == upper)
+            .ok_or_else(|| format!("{s:?}: expected none, lz4, lz4_high, zstd or zstd_high"))
     }
 }
 
@@ -591,10 +598,10 @@ mod tests {
     fn compression_names_round_trip() {
         for code in 0..5 {
             let c = Compression::from_code(code).unwrap();
-            assert_eq!(Compression::parse(c.name()), Some(c));
+            assert_eq!(c.name().parse::<Compression>(), Ok(c));
             assert_eq!(c.code(), code);
         }
-        assert_eq!(Compression::parse("lz4-high"), Some(Compression::Lz4High));
+        assert_eq!("lz4-high".parse::<Compression>(), Ok(Compression::Lz4High));
         assert_eq!(Compression::from_code(7), None);
     }
 }

@@ -1,7 +1,7 @@
 //! AEDAT 4.0 writer: event packets of a fixed size, compressed in parallel, a FileDataTable at
-//! the end, written to a temporary file that is renamed into place by [`Aedat4Writer::finish`].
+//! the end, and the header's table position patched in by [`Aedat4Writer::finish`] (so the
+//! sink must seek). Writing whole or not at all is the caller's: see `eenf::output`.
 
-use std::fs::File;
 use std::io::{BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use super::flatbuf::Builder;
 use super::{Compression, EVENT_SIZE, MAGIC};
 use crate::error::{io_err, Result};
+use crate::writers::Sink;
 use crate::EventBatch;
 
 /// Events per packet, as the DV software writes them.
@@ -28,8 +29,7 @@ struct TableEntry {
 /// Writes events to an AEDAT 4.0 file with one event stream (id 0).
 pub struct Aedat4Writer {
     path: PathBuf,
-    tmp_path: PathBuf,
-    file: Option<BufWriter<File>>,
+    file: Option<BufWriter<Box<dyn Sink>>>,
     codec: Compression,
     width: u16,
     height: u16,
@@ -109,22 +109,29 @@ fn event_packet(batch: &EventBatch, range: std::ops::Range<usize>) -> Vec<u8> {
 }
 
 impl Aedat4Writer {
-    /// Starts a file at `path` (written to a temporary file beside it until [`finish`]).
-    ///
-    /// [`finish`]: Aedat4Writer::finish
+    /// Starts a plain file at `path` (created, or truncated).
     pub fn create(path: &Path, codec: Compression, width: u16, height: u16) -> Result<Self> {
-        let tmp_path = crate::tmp_path_for(path);
-        let file = File::create(&tmp_path).map_err(|e| io_err(&tmp_path, e))?;
-        let mut file = BufWriter::with_capacity(1 << 20, file);
+        let file = std::fs::File::create(path).map_err(|e| io_err(path, e))?;
+        Self::new(Box::new(file), path, codec, width, height)
+    }
+
+    /// Starts writing into `out`; `name` names it in errors.
+    pub fn new(
+        out: Box<dyn Sink>,
+        name: &Path,
+        codec: Compression,
+        width: u16,
+        height: u16,
+    ) -> Result<Self> {
+        let mut file = BufWriter::with_capacity(1 << 20, out);
         let header = io_header(codec, -1, &info_xml(codec, width, height));
         let mut head = Vec::with_capacity(18 + header.len());
         head.extend_from_slice(MAGIC);
         head.extend_from_slice(&(header.len() as u32).to_le_bytes());
         head.extend_from_slice(&header);
-        file.write_all(&head).map_err(|e| io_err(&tmp_path, e))?;
+        file.write_all(&head).map_err(|e| io_err(name, e))?;
         Ok(Aedat4Writer {
-            path: path.to_path_buf(),
-            tmp_path,
+            path: name.to_path_buf(),
             file: Some(file),
             codec,
             width,
@@ -172,12 +179,12 @@ impl Aedat4Writer {
             .collect();
         let file = self.file.as_mut().expect("writer used after finish");
         for (r, body) in ranges.iter().zip(packets) {
-            let body = body.map_err(|e| io_err(&self.tmp_path, e))?;
+            let body = body.map_err(|e| io_err(&self.path, e))?;
             let mut hdr = [0u8; 8];
             hdr[4..8].copy_from_slice(&(body.len() as i32).to_le_bytes());
             file.write_all(&hdr)
                 .and_then(|_| file.write_all(&body))
-                .map_err(|e| io_err(&self.tmp_path, e))?;
+                .map_err(|e| io_err(&self.path, e))?;
             self.entries.push(TableEntry {
                 byte_offset: self.pos as i64 + 8,
                 size: body.len() as i32,
@@ -219,7 +226,7 @@ impl Aedat4Writer {
         b.finish_size_prefixed(t, b"FTAB")
     }
 
-    /// Writes the remaining events and the FileDataTable, then moves the file into place.
+    /// Writes the remaining events and the FileDataTable, patches the header and flushes.
     /// Returns the number of events written.
     pub fn finish(mut self) -> Result<u64> {
         self.flush_packets(true)?;
@@ -232,25 +239,13 @@ impl Aedat4Writer {
         );
         debug_assert_eq!(header.len(), self.header_len);
         let mut file = self.file.take().expect("finish called once");
-        let tmp = self.tmp_path.clone();
         (|| -> std::io::Result<()> {
             file.write_all(&table)?;
             file.seek(SeekFrom::Start(18))?;
             file.write_all(&header)?;
-            let f = file.into_inner().map_err(|e| e.into_error())?;
-            f.sync_all()
+            file.flush()
         })()
-        .map_err(|e| io_err(&tmp, e))?;
-        crate::commit_tmp(&tmp, &self.path).map_err(|e| io_err(&self.path, e))?;
+        .map_err(|e| io_err(&self.path, e))?;
         Ok(self.written)
-    }
-}
-
-impl Drop for Aedat4Writer {
-    fn drop(&mut self) {
-        // An unfinished writer leaves nothing behind.
-        if self.file.take().is_some() {
-            let _ = std::fs::remove_file(&self.tmp_path);
-        }
     }
 }

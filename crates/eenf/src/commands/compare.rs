@@ -1,17 +1,16 @@
 //! `eenf compare`: agreement of an ENF trace with a reference.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Result;
-use eenf_cli::dataset::recording_start;
-use eenf_cli::evaluate::{self, Comparison, Reference};
-use eenf_cli::output::{read_trace, TraceFile};
-use eenf_cli::pipeline::Nominal;
-use eenf_cli::plot::plot_comparison;
-use eenf_cli::progress::Progress;
-use eenf_dsp::EnfParams;
+use eenf::evaluate::compare_trace;
+use eenf::extract::Nominal;
+use eenf::plot::plot_comparison;
+use eenf::progress::Progress;
+use eenf::trace::Trace;
+use eenf_dsp::{EnfParams, PeakMethod};
 
-use super::method::Peak;
+use super::args::one_of;
 
 /// Arguments of `eenf compare`.
 #[derive(Debug, clap::Args)]
@@ -35,58 +34,18 @@ pub struct Args {
     #[arg(long, default_value = "auto")]
     pub nominal: Nominal,
     /// Peak refinement for a WAV reference (default: the estimate's, else exact).
-    #[arg(long, value_enum)]
-    pub peak: Option<Peak>,
-}
-
-/// The estimate's peak method, from its JSON metadata.
-fn estimate_peak(path: &Path) -> Option<eenf_dsp::PeakMethod> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    serde_json::from_value(v["params"]["peak"].clone()).ok()
-}
-
-/// Compares the trace file `est` (read from `est_path`) with the reference at `reference`.
-pub fn compare(
-    est: &TraceFile,
-    est_path: &Path,
-    reference: &Path,
-    offset_s: f64,
-    nominal: Nominal,
-    params: &EnfParams,
-) -> Result<Comparison> {
-    let source = est.source.clone().unwrap_or_else(|| est_path.to_path_buf());
-    // the recording's name, else the trace file's own, says when it started
-    let named = if recording_start(&source).is_some() {
-        source
-    } else {
-        est_path.to_path_buf()
-    };
-    let (reference, offset) = Reference::resolve(reference, &named, offset_s)?;
-    evaluate::compare(
-        &est.time_s,
-        &est.enf_hz,
-        est_path,
-        &reference,
-        offset,
-        nominal,
-        params,
-    )
+    #[arg(long, value_parser = one_of::<PeakMethod>(&PeakMethod::NAMES))]
+    pub peak: Option<PeakMethod>,
 }
 
 pub fn run(a: Args, progress: Progress) -> Result<()> {
-    let est = read_trace(&a.estimate)?;
-    let peak = a
-        .peak
-        .map(Into::into)
-        .or_else(|| estimate_peak(&a.estimate))
-        .unwrap_or(eenf_dsp::PeakMethod::Exact);
+    let est = Trace::read(&a.estimate, None)?;
     let params = EnfParams {
-        peak,
+        peak: a.peak.or_else(|| est.peak()).unwrap_or(PeakMethod::Exact),
         ..EnfParams::default()
     };
     let spin = progress.spinner("comparing");
-    let c = compare(
+    let c = compare_trace(
         &est,
         &a.estimate,
         &a.reference,

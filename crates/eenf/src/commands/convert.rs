@@ -2,10 +2,12 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
-use eenf_cli::progress::Progress;
-use eenf_events::writers::{create, OutputFormat};
-use eenf_events::{Compression, StreamStats};
+use anyhow::{bail, Result};
+use eenf::output::write_events;
+use eenf::progress::Progress;
+use eenf_events::StreamStats;
+
+use super::args::EventOutputArgs;
 
 /// Arguments of `eenf convert`.
 #[derive(Debug, clap::Args)]
@@ -14,39 +16,12 @@ pub struct Args {
     pub input: PathBuf,
     /// The output file.
     pub output: PathBuf,
-    /// Output format: aedat4, evt2, evt3, dat, text (default: from the output's extension:
-    /// .aedat4, .raw = evt3, .dat, .txt/.csv).
-    #[arg(long)]
-    pub format: Option<String>,
-    /// AEDAT4 packet compression: none, lz4, lz4_high, zstd, zstd_high.
-    #[arg(long, default_value = "lz4")]
-    pub compression: String,
-}
-
-/// `--compression` → the AEDAT4 codec.
-pub fn parse_codec(s: &str) -> Result<Compression> {
-    Compression::parse(s).with_context(|| {
-        format!("--compression {s:?}: expected none, lz4, lz4_high, zstd or zstd_high")
-    })
-}
-
-/// `--format` → the output format.
-pub fn parse_format(f: &str, codec: Compression) -> Result<OutputFormat> {
-    OutputFormat::parse(f, codec)
-        .with_context(|| format!("--format {f:?}: expected aedat4, evt2, evt3, dat or text"))
+    #[command(flatten)]
+    pub events: EventOutputArgs,
 }
 
 pub fn run(a: Args, progress: Progress) -> Result<()> {
-    let codec = parse_codec(&a.compression)?;
-    let format = match &a.format {
-        Some(f) => parse_format(f, codec)?,
-        None => OutputFormat::from_extension(&a.output, codec).with_context(|| {
-            format!(
-                "{}: cannot tell the output format from the name; pass --format aedat4|evt2|evt3|dat|text",
-                a.output.display()
-            )
-        })?,
-    };
+    let format = a.events.format_for(&a.output, None)?;
     if a.input.canonicalize().ok() == a.output.canonicalize().ok() && a.output.exists() {
         bail!("{}: input and output are the same file", a.output.display());
     }
@@ -65,21 +40,21 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             )
         }
     };
-    let mut writer = create(&a.output, format, width, height)?;
     let bar = progress.events(info.event_count, "converting");
-    while let Some(batch) = reader.next_batch()? {
-        writer.write(&batch)?;
-        bar.inc(batch.len() as u64);
-    }
+    let n = write_events(&a.output, format, width, height, |writer| {
+        while let Some(batch) = reader.next_batch()? {
+            writer.write(&batch)?;
+            bar.inc(batch.len() as u64);
+        }
+        Ok(())
+    })?;
     bar.finish_and_clear();
-    let n = writer.finish()?;
     let took = started.elapsed().as_secs_f64();
     eprintln!(
-        "{} ({}) -> {} ({}): {n} events, {width}x{height}, in {took:.2} s ({:.1} M events/s)",
+        "{} ({}) -> {} ({format}): {n} events, {width}x{height}, in {took:.2} s ({:.1} M events/s)",
         a.input.display(),
         info.format,
         a.output.display(),
-        format.name(),
         n as f64 / took.max(1e-9) / 1e6
     );
     Ok(())

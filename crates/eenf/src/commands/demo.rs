@@ -3,14 +3,15 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use eenf_cli::output::read_trace;
-use eenf_cli::pipeline::{extract_file, ExtractOptions, Nominal};
-use eenf_cli::plot::{plot_comparison, plot_extraction};
-use eenf_cli::progress::Progress;
+use eenf::evaluate::compare_trace;
+use eenf::extract::{extract_file, ExtractOptions, Nominal};
+use eenf::output::{sibling, write_atomic};
+use eenf::plot::{plot_comparison, plot_extraction};
+use eenf::progress::Progress;
+use eenf::simulation::{simulate_recording, Recipe};
+use eenf::trace::Trace;
 use eenf_dsp::EnfParams;
-
-use super::compare::compare;
-use super::simulate::{self, sibling};
+use eenf_sim::{SceneKind, SimConfig};
 
 /// Arguments of `eenf demo`.
 #[derive(Debug, clap::Args)]
@@ -33,15 +34,13 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         "1/3 simulating {:.0} s of a lamp-lit scene on a 50 Hz grid...",
         a.duration
     );
-    let sim = simulate::run(
-        simulate::Args {
-            duration: a.duration,
-            output: recording.clone(),
-            seed: a.seed,
-            ..simulate::Args::default()
-        },
-        progress,
-    )?;
+    let config = SimConfig {
+        duration_s: a.duration,
+        seed: a.seed,
+        ..SimConfig::default()
+    }
+    .with_kinds(&[SceneKind::Static]);
+    let sim = simulate_recording(&Recipe::new(config, recording.clone()), &progress)?.sim;
     println!(
         "    {} events in {:.1} s -> {}",
         sim.stats.events,
@@ -55,28 +54,29 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         nominal: Nominal::Auto,
         ..ExtractOptions::default()
     };
-    let x = extract_file(&recording, &opts, &progress)?;
+    let trace = extract_file(&recording, &opts, &progress)?;
     let trace_csv = sibling(&recording, "enf.csv");
     let trace_json = sibling(&recording, "enf.json");
-    super::extract::save(&x, &trace_csv)?;
-    super::extract::save(&x, &trace_json)?;
+    for p in [&trace_csv, &trace_json] {
+        write_atomic(p, |w| trace.write_for(p, w))?;
+    }
     let extract_plot = sibling(&recording, "extract.png");
     plot_extraction(
         &extract_plot,
         "demo: ENF per harmonic and the selected harmonic",
-        &x.trace,
+        &trace,
     )?;
     println!(
         "    detected a {} Hz grid; {} estimates in {:.2} s -> {}",
-        x.params.nominal_hz,
-        x.trace.enf_hz.len(),
+        trace.nominal_hz.unwrap_or(f64::NAN),
+        trace.enf_hz.len(),
         started.elapsed().as_secs_f64(),
         trace_csv.display()
     );
 
     println!("3/3 comparing with the simulator's ground truth...");
-    let est = read_trace(&trace_csv)?;
-    let c = compare(
+    let est = Trace::read(&trace_csv, None)?;
+    let c = compare_trace(
         &est,
         &trace_csv,
         &sim.truth,

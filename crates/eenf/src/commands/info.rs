@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use eenf_cli::output::utc_string;
+use eenf::time::utc_micros;
 use eenf_events::StreamStats;
 
 /// Arguments of `eenf info`.
@@ -81,8 +81,8 @@ pub fn run(a: Args) -> Result<()> {
         stats.events - stats.on
     );
     if let (Some(f), Some(l)) = (stats.first_t, stats.last_t) {
-        println!("first t     {f} us ({})", utc_string(f));
-        println!("last t      {l} us ({})", utc_string(l));
+        println!("first t     {f} us ({})", utc_micros(f));
+        println!("last t      {l} us ({})", utc_micros(l));
         println!("duration    {duration_s:.6} s");
         println!("rate        {:.3} M events/s", rate / 1e6);
     }

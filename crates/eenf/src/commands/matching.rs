@@ -1,20 +1,16 @@
 //! `eenf match`: when was this recorded?
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use eenf_cli::dataset::hourly_references;
-use eenf_cli::output::read_trace;
-use eenf_cli::pipeline::{reference_file, Nominal};
-use eenf_cli::plot::plot_comparison;
-use eenf_cli::progress::Progress;
-use eenf_cli::refdb::{parse_time, tz_offset, utc, RefSeries, GAP};
-use eenf_dsp::matching::{
-    match_trace, resample, MatchOptions, ReferenceValues, ScaledSeries, Score, DEFAULT_ALPHA,
-};
-use eenf_dsp::EnfParams;
+use eenf::plot::plot_comparison;
+use eenf::progress::Progress;
+use eenf::reference::ReferenceSeries;
+use eenf::time::{parse_time, tz_offset};
+use eenf::trace::Trace;
+use eenf_dsp::matching::{resample, MatchOptions, Score, DEFAULT_ALPHA};
 
-use super::refdb::wav_start;
+use super::args::one_of;
 
 /// Arguments of `eenf match`.
 #[derive(Debug, clap::Args)]
@@ -32,8 +28,8 @@ pub struct Args {
     #[arg(long)]
     pub verify: Option<String>,
     /// Ranking score: `combined` (shape and level) or `cc` (shape only, robust to a bias).
-    #[arg(long, value_enum, default_value_t = ScoreArg::Combined)]
-    pub score: ScoreArg,
+    #[arg(long, default_value = "combined", value_parser = one_of::<Score>(&Score::NAMES))]
+    pub score: Score,
     /// A candidate is a match when its p-value is below this.
     #[arg(long, default_value_t = DEFAULT_ALPHA)]
     pub alpha: f64,
@@ -48,184 +44,24 @@ pub struct Args {
     pub plot: Option<PathBuf>,
 }
 
-/// Score names for clap.
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum ScoreArg {
-    /// atanh(CC) − ln(RMSE).
-    Combined,
-    /// CC alone.
-    Cc,
-}
-
-/// A reference series: start (Unix s, or 0 for relative), step, values, name.
-struct Reference {
-    name: String,
-    start: f64,
-    absolute: bool,
-    step: f64,
-    data: RefData,
-}
-
-/// Reference values: in Hz, or as stored (µHz from nominal), read in place.
-enum RefData {
-    Hz(Vec<f64>),
-    Stored { values: Vec<i32>, nominal: f64 },
-}
-
-impl RefData {
-    fn scaled(values: &[i32], nominal: f64) -> ScaledSeries<'_> {
-        ScaledSeries {
-            values,
-            offset_hz: nominal,
-            scale_hz: 1e-6,
-            gap: GAP,
-        }
-    }
-
-    fn len(&self) -> usize {
-        match self {
-            RefData::Hz(v) => v.len(),
-            RefData::Stored { values, .. } => values.len(),
-        }
-    }
-
-    fn get(&self, i: usize) -> f64 {
-        match self {
-            RefData::Hz(v) => v[i],
-            RefData::Stored { values, nominal } => Self::scaled(values, *nominal).get(i),
-        }
-    }
-
-    fn search(
-        &self,
-        q: &[f64],
-        opts: &MatchOptions,
-    ) -> Result<eenf_dsp::matching::MatchResult, eenf_dsp::matching::MatchError> {
-        match self {
-            RefData::Hz(v) => match_trace(q, &v[..], opts),
-            RefData::Stored { values, nominal } => {
-                match_trace(q, &Self::scaled(values, *nominal), opts)
-            }
-        }
-    }
-}
-
-fn load_references(
-    path: &Path,
-    nominal: f64,
-    tz: f64,
-    progress: &Progress,
-) -> Result<Vec<Reference>> {
-    if path.is_dir() {
-        let grids = RefSeries::grids(path)?;
-        if !grids.is_empty() {
-            let mut out = Vec::new();
-            for g in grids {
-                let meta = RefSeries::load_meta(path, &g)?;
-                if meta.nominal_hz != nominal {
-                    continue; // 50 and 60 Hz are never mixed
-                }
-                let s = RefSeries::load(path, &g)?;
-                out.push(Reference {
-                    name: g,
-                    start: meta.start_unix_s,
-                    absolute: true,
-                    step: meta.step_s,
-                    data: RefData::Stored {
-                        values: s.values,
-                        nominal,
-                    },
-                });
-            }
-            if out.is_empty() {
-                bail!("{}: the store holds no {nominal} Hz grid", path.display());
-            }
-            return Ok(out);
-        }
-        // a folder of hourly WAVs, assembled in memory
-        let files = hourly_references(path)?;
-        let bar = progress.steps(files.len() as u64, "tracking the references");
-        let mut series = RefSeries::new("folder", nominal, 1.0, 0.0);
-        for (_, f) in &files {
-            let (f0, trace) = reference_file(f, Nominal::Auto, &EnfParams::default())?;
-            if f0 == nominal {
-                series.merge(wav_start(f, tz)?, 1.0, &trace)?;
-            }
-            bar.inc(1);
-        }
-        bar.finish_and_clear();
-        if series.values.is_empty() {
-            bail!("{}: no {nominal} Hz references", path.display());
-        }
-        return Ok(vec![Reference {
-            name: path.display().to_string(),
-            start: series.meta.start_unix_s,
-            absolute: true,
-            step: 1.0,
-            data: RefData::Hz(series.hz()),
-        }]);
-    }
-    let mut head = [0u8; 4];
-    let is_wav = std::fs::File::open(path)
-        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
-        .map(|_| &head == b"RIFF")
-        .unwrap_or(false);
-    let (start, absolute, step, hz) = if is_wav {
-        let (_, trace) = reference_file(path, Nominal::Hz(nominal), &EnfParams::default())?;
-        match wav_start(path, tz) {
-            Ok(s) => (s, true, 1.0, trace),
-            Err(_) => (0.0, false, 1.0, trace),
-        }
-    } else {
-        let t = read_trace(path)?;
-        let step = if t.time_s.len() > 1 {
-            t.time_s[1] - t.time_s[0]
-        } else {
-            1.0
-        };
-        (
-            t.time_s.first().copied().unwrap_or(0.0),
-            false,
-            step,
-            t.enf_hz,
-        )
-    };
-    Ok(vec![Reference {
-        name: path.display().to_string(),
-        start,
-        absolute,
-        step,
-        data: RefData::Hz(hz),
-    }])
-}
-
 pub fn run(a: Args, progress: Progress) -> Result<()> {
-    let trace = read_trace(&a.trace)?;
+    let trace = Trace::read(&a.trace, None)?;
     if trace.enf_hz.len() < 2 {
         bail!("{}: too short to match", a.trace.display());
     }
-    let step = trace.time_s[1] - trace.time_s[0];
+    let step = trace.step_s;
     if step <= 0.0 {
         bail!("{}: times must increase", a.trace.display());
     }
-    let finite: Vec<f64> = trace
-        .enf_hz
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    let mean = finite.iter().sum::<f64>() / finite.len().max(1) as f64;
-    let nominal = [50.0, 60.0]
-        .into_iter()
-        .find(|f| (mean - f).abs() < 1.0)
-        .with_context(|| {
-            format!(
-                "{}: mean {mean:.3} Hz is neither a 50 nor a 60 Hz grid",
-                a.trace.display()
-            )
-        })?;
+    let nominal = trace.grid_hz().with_context(|| {
+        format!(
+            "{}: mean {:.3} Hz is neither a 50 nor a 60 Hz grid",
+            a.trace.display(),
+            trace.mean_hz()
+        )
+    })?;
     let tz = tz_offset(&a.tz)?;
-    let refs = load_references(&a.reference, nominal, tz, &progress)?;
+    let refs = ReferenceSeries::load(&a.reference, nominal, tz, &progress)?;
     let started = std::time::Instant::now();
     let mut rows = Vec::new();
     let mut verification = None;
@@ -246,15 +82,12 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         };
         let opts = MatchOptions {
             top: a.top,
-            score: match a.score {
-                ScoreArg::Combined => Score::Combined,
-                ScoreArg::Cc => Score::Cc,
-            },
+            score: a.score,
             verify,
             ..MatchOptions::default()
         };
         let res = r
-            .data
+            .values
             .search(&q, &opts)
             .map_err(|e| anyhow::anyhow!("{}: {e}", a.trace.display()))?;
         if let Some(v) = res.verification {
@@ -267,21 +100,14 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     rows.sort_by(|x, y| {
         x.1.p_value
             .total_cmp(&y.1.p_value)
-            .then(y.1.cc.total_cmp(&x.1.cc))
+            .then(y.1.agreement.cc.total_cmp(&x.1.agreement.cc))
     });
     rows.truncate(a.top);
     let took = started.elapsed().as_secs_f64();
-    let when = |r: &Reference, offset: f64| {
-        let t = r.start + offset * r.step;
-        if r.absolute {
-            utc(t)
-        } else {
-            format!("{t:.1} s")
-        }
-    };
+    let when = |r: &ReferenceSeries, offset: f64| r.time_label(offset);
     if let (Some(p), Some((r, c))) = (&a.plot, rows.first()) {
         let k = c.offset.round() as usize;
-        let n = trace.enf_hz.len().min(r.data.len().saturating_sub(k));
+        let n = trace.enf_hz.len().min(r.values.len().saturating_sub(k));
         let q = resample(&trace.enf_hz, step, r.step);
         let n = n.min(q.len());
         let t: Vec<f64> = (0..n).map(|i| i as f64 * r.step).collect();
@@ -291,12 +117,12 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
                 "{} at {}: CC {:.4}, p {:.1e}",
                 a.trace.file_name().unwrap_or_default().to_string_lossy(),
                 when(r, c.offset),
-                c.cc,
+                c.agreement.cc,
                 c.p_value
             ),
             &t,
             &q[..n],
-            &(k..k + n).map(|i| r.data.get(i)).collect::<Vec<_>>(),
+            &(k..k + n).map(|i| r.values.get(i)).collect::<Vec<_>>(),
         )?;
     }
     if a.json {
@@ -305,7 +131,8 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             .map(|(r, c)| {
                 serde_json::json!({"reference": r.name, "start": when(r, c.offset),
                     "start_s": r.start + c.offset * r.step, "offset_steps": c.offset,
-                    "cc": c.cc, "mae_hz": c.mae_hz, "rmse_hz": c.rmse_hz, "overlap": c.overlap,
+                    "cc": c.agreement.cc, "mae_hz": c.agreement.mae_hz,
+                    "rmse_hz": c.agreement.rmse_hz, "overlap": c.agreement.n,
                     "p_value": c.p_value, "match": c.p_value < a.alpha})
             })
             .collect();
@@ -313,8 +140,8 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             "trace": a.trace, "nominal_hz": nominal, "alpha": a.alpha, "seconds": took,
             "candidates": cands,
             "verify": verification.map(|(r, v)| serde_json::json!({
-                "time": when(r, v.offset as f64), "cc": v.cc, "mae_hz": v.mae_hz,
-                "rmse_hz": v.rmse_hz, "rank": v.rank, "p_value": v.p_value,
+                "time": when(r, v.offset as f64), "cc": v.agreement.cc,
+                "mae_hz": v.agreement.mae_hz, "rmse_hz": v.agreement.rmse_hz, "rank": v.rank, "p_value": v.p_value,
                 "best_fit": v.rank == 1, "consistent": v.rank == 1 && v.p_value < a.alpha})),
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
@@ -335,10 +162,10 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             "{:>4}  {:<28} {:>8.4} {:>9.3} {:>9.3} {:>8} {:>9.1e}{}",
             i + 1,
             when(r, c.offset),
-            c.cc,
-            c.mae_hz * 1e3,
-            c.rmse_hz * 1e3,
-            c.overlap,
+            c.agreement.cc,
+            c.agreement.mae_hz * 1e3,
+            c.agreement.rmse_hz * 1e3,
+            c.agreement.n,
             c.p_value,
             if c.p_value < a.alpha { "  match" } else { "" }
         );
@@ -348,8 +175,8 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             Some((r, v)) => println!(
                 "claimed {t} ({}): CC {:.4}, MAE {:.3} mHz, rank {}, p {:.1e}: {}",
                 when(r, v.offset as f64),
-                v.cc,
-                v.mae_hz * 1e3,
+                v.agreement.cc,
+                v.agreement.mae_hz * 1e3,
                 v.rank,
                 v.p_value,
                 match (v.rank == 1, v.p_value < a.alpha) {

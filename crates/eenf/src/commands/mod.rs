@@ -7,7 +7,7 @@ pub mod demo;
 pub mod extract;
 pub mod info;
 pub mod matching;
-pub mod method;
+pub mod args;
 pub mod refdb;
 pub mod reference;
 pub mod simulate;

@@ -3,12 +3,13 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use eenf_cli::dataset::reference_hour;
-use eenf_cli::output::read_series_csv;
-use eenf_cli::pipeline::{days_from_civil, reference_file, Nominal};
-use eenf_cli::progress::Progress;
-use eenf_cli::refdb::{parse_time, tz_offset, utc, RefSeries, GAP};
-use eenf_cli::wav::is_wav;
+use eenf::extract::Nominal;
+use eenf::progress::Progress;
+use eenf::refdb::{RefSeries, GAP};
+use eenf::reference::{reference_file, wav_start};
+use eenf::time::{parse_time, tz_offset, utc};
+use eenf::trace::Trace;
+use eenf::wav::is_wav;
 use eenf_dsp::EnfParams;
 
 /// `eenf refdb` subcommands.
@@ -48,30 +49,6 @@ pub struct BuildArgs {
     pub step: Option<f64>,
 }
 
-fn nominal_of(values: &[f64], what: &str) -> Result<f64> {
-    let v: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
-    if v.is_empty() {
-        bail!("{what}: no values");
-    }
-    let mean = v.iter().sum::<f64>() / v.len() as f64;
-    [50.0, 60.0]
-        .into_iter()
-        .find(|f| (mean - f).abs() < 1.0)
-        .with_context(|| format!("{what}: mean {mean:.3} Hz is neither a 50 nor a 60 Hz grid"))
-}
-
-/// Unix time of an hourly reference's name in local time at `tz`.
-pub fn wav_start(path: &Path, tz: f64) -> Result<f64> {
-    let t = reference_hour(path).with_context(|| {
-        format!(
-            "{}: the name gives no start time (expected 2022_08_17_Wed_16_00_00.wav)",
-            path.display()
-        )
-    })?;
-    let days = days_from_civil(t.year as i64, t.month, t.day);
-    Ok(days as f64 * 86_400.0 + (t.hour * 3600 + t.minute * 60 + t.second) as f64 - tz)
-}
-
 fn build(a: BuildArgs, progress: Progress) -> Result<()> {
     let tz = tz_offset(&a.tz)?;
     let bar = progress.steps(a.inputs.len() as u64, "adding references");
@@ -82,21 +59,22 @@ fn build(a: BuildArgs, progress: Progress) -> Result<()> {
             Some((p, t)) if !Path::new(input).exists() => (PathBuf::from(p), Some(parse_time(t)?)),
             _ => (PathBuf::from(input), None),
         };
-        let (start, step, values) = if is_wav(&path) {
-            let (_, trace) = reference_file(&path, Nominal::Auto, &EnfParams::default())?;
-            (at.unwrap_or(wav_start(&path, tz)?), 1.0, trace)
+        let (start, trace) = if is_wav(&path) {
+            let trace = reference_file(&path, Nominal::Auto, &EnfParams::default())?;
+            (at.unwrap_or(wav_start(&path, tz)?), trace)
         } else {
-            let (step, values) = read_series_csv(&path, a.step)?;
+            let trace = read_series(&path, a.step)?;
             let start = at.or(next_start).with_context(|| {
                 format!(
                     "{}: give its start as FILE@TIME or with --start",
                     path.display()
                 )
             })?;
-            (start, step, values)
+            (start, trace)
         };
+        let (step, values) = (trace.step_s, &trace.enf_hz);
         next_start = Some(start + values.len() as f64 * step);
-        let f0 = nominal_of(&values, &path.display().to_string())?;
+        let f0 = nominal_of(&trace, &path)?;
         let grid = a
             .grid
             .clone()
@@ -121,7 +99,7 @@ fn build(a: BuildArgs, progress: Progress) -> Result<()> {
                 s.meta.nominal_hz
             );
         }
-        s.merge(start, step, &values)?;
+        s.merge(start, step, values)?;
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -169,6 +147,30 @@ fn info(store: &Path) -> Result<()> {
         println!();
     }
     Ok(())
+}
+
+/// A trace CSV (`time_s,enf_hz`) or, with `step`, an `index,value` CSV.
+fn read_series(path: &Path, step: Option<f64>) -> Result<Trace> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+    let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
+    if step.is_none() && !header.contains("time_s") {
+        bail!("{}: an index CSV needs --step", path.display());
+    }
+    Trace::parse(&text, path, step)
+}
+
+/// The grid of a trace's values, 50 or 60 Hz.
+fn nominal_of(trace: &Trace, path: &Path) -> Result<f64> {
+    if trace.finite().next().is_none() {
+        bail!("{}: no values", path.display());
+    }
+    trace.grid_hz().with_context(|| {
+        format!(
+            "{}: mean {:.3} Hz is neither a 50 nor a 60 Hz grid",
+            path.display(),
+            trace.mean_hz()
+        )
+    })
 }
 
 pub fn run(cmd: Cmd, progress: Progress) -> Result<()> {

@@ -1,19 +1,17 @@
 //! `eenf simulate-dataset`: a synthetic EV-ENFD, laid out like the paper's dataset.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use eenf_cli::dataset::StartTime;
-use eenf_cli::output::write_atomic;
-use eenf_cli::progress::Progress;
-use eenf_cli::refdb::tz_offset;
-use eenf_cli::simulation::{write_recording, write_video, EnfTimeline};
+use eenf::dataset::{plan_dataset, recording_name, reference_name, relative, DatasetSpec};
+use eenf::output::write_atomic;
+use eenf::progress::Progress;
+use eenf::simulation::{write_recording, write_video, EnfTimeline};
+use eenf::time::{tz_offset, LocalTime};
 use eenf_events::writers::OutputFormat;
-use eenf_sim::{Lamp, LampKind, Readout, SceneKind, SimConfig};
-use rand::{Rng, SeedableRng};
+use eenf_events::Compression;
 
-use super::convert::parse_codec;
-use super::simulate::{parse_resolution, VideoArgs};
+use super::args::{one_of, parse_readout, parse_resolution, VideoArgs};
 
 /// Arguments of `eenf simulate-dataset`.
 #[derive(Debug, Clone, clap::Args)]
@@ -51,8 +49,8 @@ pub struct Args {
     #[arg(long, default_value = "dvxplorer")]
     pub readout: String,
     /// AEDAT4 packet compression.
-    #[arg(long, default_value = "lz4")]
-    pub compression: String,
+    #[arg(long, default_value = "lz4", value_parser = one_of::<Compression>(&Compression::NAMES))]
+    pub compression: Compression,
     /// Random seed of the whole dataset.
     #[arg(long, default_value_t = 2023)]
     pub seed: u64,
@@ -60,115 +58,39 @@ pub struct Args {
     pub video: VideoArgs,
 }
 
-/// One planned recording.
-struct Plan {
-    class: &'static str,
-    kinds: Vec<SceneKind>,
-    local_start: i64,
-    config: SimConfig,
-}
-
-/// A random lamp set: one to three lamps of the three kinds, on the phases of a three-phase
-/// supply when there are several.
-fn random_lamps(rng: &mut rand::rngs::StdRng) -> Vec<Lamp> {
-    let count = match rng.gen_range(0..10) {
-        0..=5 => 1,
-        6..=8 => 2,
-        _ => 3,
-    };
-    let phases = [0.0, 120.0, 240.0];
-    let offset = rng.gen_range(0..3);
-    (0..count)
-        .map(|k| {
-            let kind = match rng.gen_range(0..10) {
-                0..=5 => LampKind::Led {
-                    depth: rng.gen_range(0.35..0.6),
-                    sharpness: [1.0, 1.0, 2.0][rng.gen_range(0..3)],
-                    smoothing_ms: rng.gen_range(0.1..0.6),
-                },
-                6..=8 => LampKind::Incandescent {
-                    tau_ms: rng.gen_range(8.0..20.0),
-                },
-                _ => LampKind::Fluorescent {
-                    lag_rad: rng.gen_range(0.2..0.5),
-                    dead: rng.gen_range(0.08..0.2),
-                    phosphor_ms: rng.gen_range(0.8..2.5),
-                },
-            };
-            Lamp {
-                kind,
-                phase_deg: if count > 1 {
-                    phases[(offset + k) % 3]
-                } else {
-                    0.0
-                },
-                share: rng.gen_range(0.5..1.5),
-            }
-        })
-        .collect()
-}
-
-/// Recordings of a preset: (class, scene kinds) each.
-type Classes = Vec<(&'static str, Vec<SceneKind>)>;
-
-/// The classes and scene kinds of a preset, and its recording length and resolution.
-fn preset(name: &str) -> Result<(Classes, f64, &'static str)> {
-    use SceneKind::*;
-    let cycle = |class: &'static str, n: usize, kinds: &[&[SceneKind]]| {
-        (0..n)
-            .map(|i| (class, kinds[i % kinds.len()].to_vec()))
-            .collect::<Vec<_>>()
-    };
-    let dynamic: &[&[SceneKind]] = &[
-        &[DynamicObject],
-        &[DynamicCamera],
-        &[DynamicObject, DynamicCamera],
-    ];
-    let extreme: &[&[SceneKind]] = &[&[ExtremeDim], &[ExtremeBright]];
-    let (n, duration, res) = match name {
-        "ev-enfd" => ([16, 25, 10], 180.0, "48x36"),
-        "small" => ([3, 3, 3], 120.0, "48x36"),
-        other => bail!("--preset {other:?}: expected ev-enfd or small"),
-    };
-    let mut plans = cycle("static", n[0], &[&[Static]]);
-    plans.extend(cycle("dynamic", n[1], dynamic));
-    plans.extend(cycle("extreme", n[2], extreme));
-    Ok((plans, duration, res))
-}
-
 /// Local seconds of `2022-08-17T16` (date and hour, minutes optional).
 fn parse_local_hour(s: &str) -> Result<i64> {
     let bad =
         || anyhow::anyhow!("--start {s:?}: expected a local date and hour like 2022-08-17T16");
     let (date, hour) = s.split_once(['T', ' ']).ok_or_else(bad)?;
-    let d: Vec<u32> = date
+    let d: Vec<i16> = date
         .split('-')
         .map(|p| p.parse().map_err(|_| bad()))
         .collect::<Result<_>>()?;
-    let h: u32 = hour
+    let h: i8 = hour
         .split(':')
         .next()
         .and_then(|h| h.parse().ok())
         .ok_or_else(bad)?;
-    if d.len() != 3 || !(1..=12).contains(&d[1]) || !(1..=31).contains(&d[2]) || h > 23 {
+    if d.len() != 3 || !(1..=12).contains(&d[1]) || !(1..=31).contains(&d[2]) {
         return Err(bad());
     }
-    Ok(eenf_cli::pipeline::days_from_civil(d[0] as i64, d[1], d[2]) * 86_400 + h as i64 * 3600)
+    let t = LocalTime::new(d[0], d[1] as i8, d[2] as i8, h, 0, 0).ok_or_else(bad)?;
+    Ok(t.local_seconds())
 }
 
 pub fn run(a: Args, progress: Progress) -> Result<()> {
-    let (classes, preset_duration, preset_res) = preset(&a.preset)?;
-    let duration = a.duration.unwrap_or(preset_duration);
-    if !(20.0..=3600.0).contains(&duration) {
-        bail!("--duration must be between 20 and 3600 s");
-    }
-    let (width, height) = parse_resolution(a.resolution.as_deref().unwrap_or(preset_res))?;
-    let readout = Readout::named(&a.readout)
-        .with_context(|| format!("--readout {:?}: expected dvxplorer or prophesee", a.readout))?;
-    let codec = parse_codec(&a.compression)?;
+    let spec = DatasetSpec {
+        preset: a.preset.clone(),
+        duration_s: a.duration,
+        resolution: a.resolution.as_deref().map(parse_resolution).transpose()?,
+        readout: parse_readout(&a.readout)?,
+        tz_s: tz_offset(&a.tz)?,
+        seed: a.seed,
+    };
+    let codec = a.compression;
     let cameras = a.video.cameras()?;
-    let tz = tz_offset(&a.tz)?;
-
+    let tz = spec.tz_s;
     let timeline = match &a.enf_dir {
         Some(dir) => EnfTimeline::wav_dir(dir)?,
         None => {
@@ -179,59 +101,8 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             EnfTimeline::synthetic(a.grid as f64, from, from + 6.0 * 3600.0, a.seed ^ 0xe4f)
         }
     };
-    let (from, to) = timeline.coverage()?;
-    // recordings start at distinct whole seconds spread over the coverage, 30 s from its ends
-    // (one may run across an hour: the references continue in the next file)
-    let (lo, hi) = (from.ceil() as i64 + 30, (to - duration).floor() as i64 - 30);
-    if hi <= lo + classes.len() as i64 {
-        bail!(
-            "the ENF covers {:.0} s, too little for {} recordings of {duration} s",
-            to - from,
-            classes.len()
-        );
-    }
-    let mut rng = rand::rngs::StdRng::seed_from_u64(a.seed);
-    let mut starts: Vec<i64> = Vec::new();
-    while starts.len() < classes.len() {
-        let s = rng.gen_range(lo..hi);
-        if starts.iter().all(|&t| (t - s).abs() > 5) {
-            starts.push(s);
-        }
-    }
-    let plans: Vec<Plan> = classes
-        .into_iter()
-        .zip(starts)
-        .enumerate()
-        .map(|(i, ((class, kinds), local_start))| {
-            let seed = a.seed.wrapping_mul(1000).wrapping_add(i as u64);
-            let mut r = rand::rngs::StdRng::seed_from_u64(seed ^ 0x1a4b);
-            let mut config = SimConfig {
-                width,
-                height,
-                duration_s: duration,
-                start_us: ((local_start as f64 - tz) * 1e6) as i64,
-                seed,
-                lamps: random_lamps(&mut r),
-                ambient: r.gen_range(0.05..0.35),
-                illumination: r.gen_range(0.5..2.0),
-                readout: readout.clone(),
-                ..SimConfig::default()
-            }
-            .with_kinds(&kinds);
-            // a little variety in the sensor's bias settings
-            config.pixel.threshold = r.gen_range(0.17..0.25);
-            if kinds.contains(&SceneKind::ExtremeDim) {
-                // night scenes from ~1 to ~6 lux on a white wall
-                config.illumination = r.gen_range(0.004..0.02);
-            }
-            Plan {
-                class,
-                kinds,
-                local_start,
-                config,
-            }
-        })
-        .collect();
+    let (plans, duration) = plan_dataset(&spec, timeline.coverage()?)?;
+    let (width, height) = (plans[0].config.width, plans[0].config.height);
 
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("{}", a.out_dir.display()))?;
     let ref_dir = a.out_dir.join("ENF_Reference");
@@ -257,8 +128,8 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     for plan in &plans {
         let dir = a.out_dir.join(plan.class);
         std::fs::create_dir_all(&dir).with_context(|| format!("{}", dir.display()))?;
-        let t = StartTime::from_local_seconds(plan.local_start);
-        let path = dir.join(t.recording_name("aedat4"));
+        let t = LocalTime::from_local_seconds(plan.local_start);
+        let path = dir.join(recording_name(&t, "aedat4"));
         let mains = timeline.phase(plan.local_start as f64, duration)?;
         let kinds: Vec<&str> = plan.kinds.iter().map(|k| k.name()).collect();
         let extra = serde_json::json!({
@@ -280,7 +151,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         for camera in &cameras {
             let hidden = Progress::hidden();
             for v in write_video(&plan.config, camera, &mains, &path, a.video.mp4, &hidden)? {
-                videos.push(rel(&a.out_dir, &v));
+                videos.push(relative(&a.out_dir, &v));
             }
         }
         let lamps: Vec<String> = plan
@@ -297,9 +168,9 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             .collect();
         rows.push(format!(
             "{},{},{},{},{},{},{},{},{},{}",
-            rel(&a.out_dir, &path),
+            relative(&a.out_dir, &path),
             plan.class,
-            rel(&a.out_dir, &ref_dir.join(t.reference_name())),
+            relative(&a.out_dir, &ref_dir.join(reference_name(&t))),
             t.second_of_hour(),
             videos.join(";"),
             kinds.join("+"),
@@ -348,12 +219,4 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         a.out_dir.display()
     );
     Ok(())
-}
-
-/// `path` relative to `base` (with `/`), for the manifest.
-fn rel(base: &Path, path: &Path) -> String {
-    path.strip_prefix(base)
-        .unwrap_or(path)
-        .to_string_lossy()
-        .replace('\\', "/")
 }

@@ -1,0 +1,298 @@
+//! Mains references: the ENF of a mains (or audio) recording, the reference of one recording
+//! from a dataset's hourly WAVs, and the long reference series that `match` searches.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use eenf_dsp::matching::{match_trace, MatchError, MatchOptions, MatchResult, ScaledSeries};
+use eenf_dsp::{check_line, detect_nominal, reference_enf, EnfParams};
+
+use crate::dataset::hourly_references;
+use crate::extract::Nominal;
+use crate::progress::Progress;
+use crate::refdb::{RefSeries, GAP};
+use crate::time::LocalTime;
+use crate::trace::Trace;
+use crate::wav::{read_wav, Signal};
+
+/// Decides or checks the nominal frequency of a mains signal.
+pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<f64> {
+    let err = |e: eenf_dsp::DspError| anyhow::anyhow!("{}: {e}", path.display());
+    if sig.fs < 2.0 * (50.0 + 4.0) {
+        bail!(
+            "{}: sample rate {} Hz is too low to carry a 50/60 Hz mains tone",
+            path.display(),
+            sig.fs
+        );
+    }
+    Ok(match nominal {
+        Nominal::Auto => detect_nominal(&sig.samples, sig.fs, 1.0).map_err(err)?,
+        Nominal::Hz(f) => {
+            if sig.fs < 2.0 * (f + 4.0) {
+                bail!(
+                    "{}: sample rate {} Hz is too low for a {f} Hz mains tone",
+                    path.display(),
+                    sig.fs
+                );
+            }
+            check_line(&sig.samples, sig.fs, f, 1.0).map_err(err)?;
+            f
+        }
+    })
+}
+
+/// The reference trace of a whole mains WAV.
+pub fn reference_file(path: &Path, nominal: Nominal, params: &EnfParams) -> Result<Trace> {
+    let sig = read_wav(path)?;
+    let f0 = mains_nominal(&sig, nominal, path)?;
+    let p = EnfParams {
+        nominal_hz: f0,
+        ..params.clone()
+    };
+    let enf = reference_enf(&sig.samples, sig.fs, &p)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(Trace::from_mains(path, f0, &p, enf))
+}
+
+/// The reference trace for a recording that starts at `start` (local time from its name) and
+/// lasts `seconds` estimates, from a folder of hourly WAVs. Windows near the recording's ends
+/// see the mains before and after it, continuing into the next hour's file when needed.
+pub fn reference_for_recording(
+    dir: &Path,
+    start: LocalTime,
+    seconds: usize,
+    nominal: Nominal,
+    params: &EnfParams,
+) -> Result<Trace> {
+    let files = hourly_references(dir)?;
+    let first = start.hour_index();
+    let Some(pos) = files.iter().position(|(t, _)| t.hour_index() == first) else {
+        bail!(
+            "{}: no reference for {} hour {:02} (expected a file like {}_Day_{:02}_00_00.wav)",
+            dir.display(),
+            start.date(),
+            start.hour(),
+            start.date(),
+            start.hour()
+        );
+    };
+    let margin = (params.window_s / 2.0).ceil() as usize + 2;
+    let from = start.second_of_hour() as usize;
+    let need_until = from + seconds + margin;
+    let mut samples = Vec::new();
+    let mut fs = 0.0;
+    let mut f0 = None;
+    for (k, (t, path)) in files[pos..].iter().enumerate() {
+        if t.hour_index() != first + k as i64 {
+            break;
+        }
+        let sig = read_wav(path)?;
+        if k == 0 {
+            fs = sig.fs;
+            f0 = Some(mains_nominal(&sig, nominal, path)?);
+        } else if sig.fs != fs {
+            bail!(
+                "{}: sample rate {} Hz differs from the previous hour's {fs} Hz",
+                path.display(),
+                sig.fs
+            );
+        }
+        samples.extend_from_slice(&sig.samples);
+        if samples.len() as f64 / fs >= need_until as f64 {
+            break;
+        }
+    }
+    let f0 = f0.context("no reference loaded")?;
+    let have_s = samples.len() as f64 / fs;
+    if (from + seconds) as f64 > have_s + 1.0 {
+        bail!(
+            "{}: the references cover {:.0} s from {}_{:02}:00:00; the recording needs {} s from second {from}",
+            dir.display(),
+            have_s,
+            start.date(),
+            start.hour(),
+            seconds
+        );
+    }
+    // track a slice starting on a whole second so frames fall on the hour's seconds
+    let a = from.saturating_sub(margin);
+    let b = ((need_until as f64 * fs) as usize).min(samples.len());
+    let p = EnfParams {
+        nominal_hz: f0,
+        ..params.clone()
+    };
+    let slice = &samples[(a as f64 * fs) as usize..b];
+    let trace =
+        reference_enf(slice, fs, &p).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+    let off = from - a;
+    let out: Vec<f64> = (0..seconds)
+        .map(|i| trace.get(off + i).copied().unwrap_or(f64::NAN))
+        .collect();
+    Ok(Trace::from_mains(dir, f0, &p, out))
+}
+
+
+/// Unix time of an hourly reference's name read as local time at `tz_s` seconds east of UTC.
+pub fn wav_start(path: &Path, tz_s: f64) -> Result<f64> {
+    let t = crate::dataset::reference_hour(path).with_context(|| {
+        format!(
+            "{}: the name gives no start time (expected 2022_08_17_Wed_16_00_00.wav)",
+            path.display()
+        )
+    })?;
+    Ok(t.unix_seconds(tz_s))
+}
+
+/// A long reference series that `match` searches: a store's grid, a folder of hourly WAVs, one
+/// WAV, or a trace.
+pub struct ReferenceSeries {
+    /// Its name in results.
+    pub name: String,
+    /// Time of the first value: Unix seconds when `absolute`, else seconds of the trace.
+    pub start: f64,
+    /// Whether `start` is an absolute time.
+    pub absolute: bool,
+    /// Seconds between values.
+    pub step: f64,
+    /// The values.
+    pub values: SeriesValues,
+}
+
+/// Reference values: in Hz, or as stored (µHz from nominal), read in place.
+pub enum SeriesValues {
+    /// Frequencies, Hz (NaN = gap).
+    Hz(Vec<f64>),
+    /// A store's integers.
+    Stored {
+        /// µHz from `nominal`, [`GAP`] = gap.
+        values: Vec<i32>,
+        /// The grid, Hz.
+        nominal: f64,
+    },
+}
+
+impl SeriesValues {
+    fn scaled(values: &[i32], nominal: f64) -> ScaledSeries<'_> {
+        ScaledSeries {
+            values,
+            offset_hz: nominal,
+            scale_hz: 1e-6,
+            gap: GAP,
+        }
+    }
+
+    /// Number of values.
+    pub fn len(&self) -> usize {
+        match self {
+            SeriesValues::Hz(v) => v.len(),
+            SeriesValues::Stored { values, .. } => values.len(),
+        }
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Value `i`, Hz (NaN = gap).
+    pub fn get(&self, i: usize) -> f64 {
+        use eenf_dsp::matching::ReferenceValues;
+        match self {
+            SeriesValues::Hz(v) => v[i],
+            SeriesValues::Stored { values, nominal } => Self::scaled(values, *nominal).get(i),
+        }
+    }
+
+    /// Where `q` (at this series' step) fits.
+    pub fn search(&self, q: &[f64], opts: &MatchOptions) -> Result<MatchResult, MatchError> {
+        match self {
+            SeriesValues::Hz(v) => match_trace(q, &v[..], opts),
+            SeriesValues::Stored { values, nominal } => {
+                match_trace(q, &Self::scaled(values, *nominal), opts)
+            }
+        }
+    }
+}
+
+impl ReferenceSeries {
+    /// The time of value `offset` (fractional steps allowed): UTC, or seconds of a trace.
+    pub fn time_label(&self, offset: f64) -> String {
+        let t = self.start + offset * self.step;
+        if self.absolute {
+            crate::time::utc(t)
+        } else {
+            format!("{t:.1} s")
+        }
+    }
+
+    /// The `nominal` Hz series at `path`: a store (its grids of that frequency), a folder of
+    /// hourly WAVs (traced, local names at `tz_s`), a WAV, or a trace file.
+    pub fn load(path: &Path, nominal: f64, tz_s: f64, progress: &Progress) -> Result<Vec<Self>> {
+        if path.is_dir() {
+            let grids = RefSeries::grids(path)?;
+            if !grids.is_empty() {
+                let mut out = Vec::new();
+                for g in grids {
+                    let meta = RefSeries::load_meta(path, &g)?;
+                    if meta.nominal_hz != nominal {
+                        continue; // 50 and 60 Hz are never mixed
+                    }
+                    let s = RefSeries::load(path, &g)?;
+                    out.push(ReferenceSeries {
+                        name: g,
+                        start: meta.start_unix_s,
+                        absolute: true,
+                        step: meta.step_s,
+                        values: SeriesValues::Stored {
+                            values: s.values,
+                            nominal,
+                        },
+                    });
+                }
+                if out.is_empty() {
+                    bail!("{}: the store holds no {nominal} Hz grid", path.display());
+                }
+                return Ok(out);
+            }
+            // a folder of hourly WAVs, assembled in memory
+            let files = hourly_references(path)?;
+            let bar = progress.steps(files.len() as u64, "tracking the references");
+            let mut series = RefSeries::new("folder", nominal, 1.0, 0.0);
+            for (_, f) in &files {
+                let trace = reference_file(f, Nominal::Auto, &EnfParams::default())?;
+                if trace.nominal_hz == Some(nominal) {
+                    series.merge(wav_start(f, tz_s)?, 1.0, &trace.enf_hz)?;
+                }
+                bar.inc(1);
+            }
+            bar.finish_and_clear();
+            if series.values.is_empty() {
+                bail!("{}: no {nominal} Hz references", path.display());
+            }
+            return Ok(vec![ReferenceSeries {
+                name: path.display().to_string(),
+                start: series.meta.start_unix_s,
+                absolute: true,
+                step: 1.0,
+                values: SeriesValues::Hz(series.hz()),
+            }]);
+        }
+        let (start, absolute, step, hz) = if crate::wav::is_wav(path) {
+            let trace = reference_file(path, Nominal::Hz(nominal), &EnfParams::default())?;
+            match wav_start(path, tz_s) {
+                Ok(s) => (s, true, 1.0, trace.enf_hz),
+                Err(_) => (0.0, false, 1.0, trace.enf_hz),
+            }
+        } else {
+            let t = Trace::read(path, None)?;
+            (t.time_s.first().copied().unwrap_or(0.0), false, t.step_s, t.enf_hz)
+        };
+        Ok(vec![ReferenceSeries {
+            name: path.display().to_string(),
+            start,
+            absolute,
+            step,
+            values: SeriesValues::Hz(hz),
+        }])
+    }
+}

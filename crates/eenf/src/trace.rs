@@ -1,0 +1,520 @@
+//! The one ENF trace type. E-ENF (events), V-ENF (video) and mains references all end as a
+//! [`Trace`]; `compare`, `bench`, `match` and the plots take it. This module alone reads and
+//! writes it: CSV (`time_s,enf_hz`, through `csv` + serde) and JSON (typed serde structs).
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use eenf_dsp::{EnfEstimates, EnfParams, PeakMethod, SamplingMethod};
+use eenf_video::{RowSampling, SceneRemoval, VideoAnalysis, VideoOptions};
+use serde::{Deserialize, Serialize};
+
+/// The CSV header of trace files; checks outside the code rely on these first two columns.
+pub const CSV_HEADER: &str = "time_s,enf_hz";
+
+/// One flicker harmonic's ENF estimates (E-ENF).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HarmonicPart {
+    /// Harmonic number m: the band is centred on 2m·f0.
+    pub harmonic: usize,
+    /// Band centre, Hz.
+    pub center_hz: f64,
+    /// ENF estimates on this band, Hz (NaN = none; `null` in JSON).
+    #[serde(with = "nan_as_null")]
+    pub enf_hz: Vec<f64>,
+}
+
+/// The harmonic chosen for one selection segment (E-ENF).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SelectedSegment {
+    /// Start of the segment, s from the recording's start.
+    pub start_s: f64,
+    /// Harmonic number chosen there.
+    pub harmonic: usize,
+}
+
+/// How an event recording became a trace.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EventsProvenance {
+    /// Format of the recording, e.g. `AEDAT 4.0`.
+    pub format: String,
+    /// Time of the first sample (the first event), µs as stored in the file.
+    pub start_t_us: i64,
+    /// The same as ISO 8601 UTC.
+    pub start_utc: String,
+    /// Events read.
+    pub events: u64,
+    /// Seconds covered by the polarity sequence.
+    pub duration_s: f64,
+    /// Temporal sampling used.
+    pub sampling: SamplingMethod,
+    /// Sampling interval, µs.
+    pub dt_us: i64,
+    /// Every parameter of the tracker (with the grid decided).
+    pub params: EnfParams,
+}
+
+/// Marks a V-ENF trace in JSON (`"method": "v-enf"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum VideoMethod {
+    /// Rolling-shutter V-ENF.
+    #[serde(rename = "v-enf")]
+    VEnf,
+}
+
+/// How a video became a trace.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VideoProvenance {
+    /// Always `v-enf`.
+    pub method: VideoMethod,
+    /// Frame width, pixels.
+    pub width: usize,
+    /// Frame height, pixels.
+    pub height: usize,
+    /// Frame rate.
+    pub fps: f64,
+    /// Frames read.
+    pub frames: usize,
+    /// Row sampling used.
+    pub sampling: RowSampling,
+    /// Scene removal used.
+    pub scene_removal: SceneRemoval,
+    /// Rows per frame period (real and idle), when zero-padded.
+    pub virtual_rows: Option<f64>,
+    /// Rate of the row signal, Hz.
+    pub fs_hz: f64,
+    /// The flicker line found, Hz.
+    pub line_hz: f64,
+    /// Its height above the noise.
+    pub prominence: f64,
+    /// Every parameter of the tracker.
+    pub params: EnfParams,
+}
+
+/// How a mains recording became a reference trace.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MainsProvenance {
+    /// Peak refinement used.
+    pub peak: PeakMethod,
+    /// STFT window, s.
+    pub window_s: f64,
+}
+
+/// Where a trace came from and how it was made; `None` for a bare CSV.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Provenance {
+    /// V-ENF on a video (tried first: its `method` tag is unambiguous).
+    Video(VideoProvenance),
+    /// E-ENF on an event recording.
+    Events(EventsProvenance),
+    /// A mains (or audio) recording.
+    Mains(MainsProvenance),
+}
+
+/// An ENF trace: one estimate per step from the recording's start, with how it was made.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Trace {
+    /// The recording traced (JSON metadata, else the trace file itself).
+    pub file: Option<PathBuf>,
+    /// The grid, Hz, when known.
+    pub nominal_hz: Option<f64>,
+    /// Seconds between estimates.
+    pub step_s: f64,
+    /// Seconds from the recording's start of each estimate.
+    pub time_s: Vec<f64>,
+    /// ENF, Hz (NaN = no estimate).
+    pub enf_hz: Vec<f64>,
+    /// Per-harmonic estimates (E-ENF).
+    pub harmonics: Vec<HarmonicPart>,
+    /// The harmonic chosen per selection segment (E-ENF).
+    pub selected: Vec<SelectedSegment>,
+    /// Where it came from.
+    pub provenance: Option<Provenance>,
+}
+
+/// The JSON layout (keys come out sorted, as `serde_json` maps keep them).
+#[derive(Serialize, Deserialize)]
+struct TraceJson {
+    #[serde(default)]
+    file: Option<PathBuf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    nominal_hz: Option<f64>,
+    #[serde(default)]
+    step_s: Option<f64>,
+    time_s: Vec<f64>,
+    #[serde(with = "nan_as_null")]
+    enf_hz: Vec<f64>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    harmonics: Vec<HarmonicPart>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    selected: Vec<SelectedSegment>,
+}
+
+/// Seconds `0, step, 2·step, …` for `n` estimates.
+pub fn times(n: usize, step: f64) -> Vec<f64> {
+    (0..n).map(|i| i as f64 * step).collect()
+}
+
+impl Trace {
+    /// A trace of `enf_hz` at `step_s` from time 0.
+    pub fn new(step_s: f64, enf_hz: Vec<f64>) -> Self {
+        Trace {
+            step_s,
+            time_s: times(enf_hz.len(), step_s),
+            enf_hz,
+            ..Trace::default()
+        }
+    }
+
+    /// The E-ENF trace of `estimates`, made from an event recording as `provenance` says.
+    pub fn from_events(file: &Path, estimates: &EnfEstimates, provenance: EventsProvenance) -> Self {
+        let seg = estimates.segment_len as f64 * estimates.step_s;
+        Trace {
+            file: Some(file.to_path_buf()),
+            nominal_hz: Some(provenance.params.nominal_hz),
+            harmonics: estimates
+                .harmonics
+                .iter()
+                .map(|h| HarmonicPart {
+                    harmonic: h.harmonic,
+                    center_hz: h.center_hz,
+                    enf_hz: h.enf_hz.clone(),
+                })
+                .collect(),
+            selected: estimates
+                .selected
+                .iter()
+                .enumerate()
+                .map(|(i, &m)| SelectedSegment {
+                    start_s: i as f64 * seg,
+                    harmonic: m,
+                })
+                .collect(),
+            provenance: Some(Provenance::Events(provenance)),
+            ..Trace::new(estimates.step_s, estimates.enf_hz.clone())
+        }
+    }
+
+    /// The V-ENF trace of a video analysed with `opts`.
+    pub fn from_video(file: &Path, v: &VideoAnalysis, opts: &VideoOptions) -> Self {
+        Trace {
+            file: Some(file.to_path_buf()),
+            nominal_hz: Some(v.nominal_hz),
+            provenance: Some(Provenance::Video(VideoProvenance {
+                method: VideoMethod::VEnf,
+                width: v.info.width,
+                height: v.info.height,
+                fps: v.info.fps,
+                frames: v.frames,
+                sampling: opts.sampling,
+                scene_removal: opts.scene_removal,
+                virtual_rows: v.virtual_rows,
+                fs_hz: v.fs,
+                line_hz: v.line_hz,
+                prominence: v.prominence,
+                params: opts.params.clone(),
+            })),
+            ..Trace::new(v.step_s, v.enf_hz.clone())
+        }
+    }
+
+    /// The reference trace of a mains recording, tracked on a `nominal_hz` grid with `params`.
+    pub fn from_mains(file: &Path, nominal_hz: f64, params: &EnfParams, enf_hz: Vec<f64>) -> Self {
+        Trace {
+            file: Some(file.to_path_buf()),
+            nominal_hz: Some(nominal_hz),
+            provenance: Some(Provenance::Mains(MainsProvenance {
+                peak: params.peak,
+                window_s: params.window_s,
+            })),
+            ..Trace::new(params.step_s, enf_hz)
+        }
+    }
+
+    /// The peak refinement the trace was made with, when it says.
+    pub fn peak(&self) -> Option<PeakMethod> {
+        match &self.provenance {
+            Some(Provenance::Events(p)) => Some(p.params.peak),
+            Some(Provenance::Video(p)) => Some(p.params.peak),
+            Some(Provenance::Mains(p)) => Some(p.peak),
+            None => None,
+        }
+    }
+
+    /// How an event recording became this trace (E-ENF traces only).
+    pub fn events(&self) -> Option<&EventsProvenance> {
+        match &self.provenance {
+            Some(Provenance::Events(p)) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// Seconds per harmonic-selection segment (E-ENF), from the segments' starts.
+    pub fn segment_s(&self) -> Option<f64> {
+        match self.selected.as_slice() {
+            [] => None,
+            [_] => Some(self.time_s.len() as f64 * self.step_s),
+            [a, b, ..] => Some(b.start_s - a.start_s),
+        }
+    }
+
+    /// The finite estimates.
+    pub fn finite(&self) -> impl Iterator<Item = f64> + '_ {
+        self.enf_hz.iter().copied().filter(|v| v.is_finite())
+    }
+
+    /// Mean of the finite estimates (NaN when there are none).
+    pub fn mean_hz(&self) -> f64 {
+        let (sum, n) = self.finite().fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+        if n == 0 {
+            f64::NAN
+        } else {
+            sum / n as f64
+        }
+    }
+
+    /// The grid a trace's values lie on: 50 or 60 Hz, from their mean.
+    pub fn grid_hz(&self) -> Option<f64> {
+        let mean = self.mean_hz();
+        [50.0, 60.0].into_iter().find(|f| (mean - f).abs() < 1.0)
+    }
+
+    /// Writes `time_s,enf_hz` rows (an empty field for no estimate).
+    pub fn write_csv(&self, w: &mut dyn Write) -> Result<()> {
+        let mut out = csv::WriterBuilder::new().from_writer(w);
+        out.write_record(CSV_HEADER.split(','))?;
+        for (t, f) in self.time_s.iter().zip(&self.enf_hz) {
+            let f = if f.is_finite() {
+                f.to_string()
+            } else {
+                String::new()
+            };
+            out.write_record([t.to_string(), f])?;
+        }
+        out.flush()?;
+        Ok(())
+    }
+
+    /// The JSON form: the values, the per-harmonic parts and the provenance's fields.
+    pub fn to_json_value(&self) -> serde_json::Value {
+        let core = TraceJson {
+            file: self.file.clone(),
+            nominal_hz: self.nominal_hz,
+            step_s: Some(self.step_s),
+            time_s: self.time_s.clone(),
+            enf_hz: self.enf_hz.clone(),
+            harmonics: self.harmonics.clone(),
+            selected: self.selected.clone(),
+        };
+        // serialising plain data into a JSON value cannot fail
+        let mut v = serde_json::to_value(core).unwrap_or_default();
+        if let (Some(p), Some(map)) = (&self.provenance, v.as_object_mut()) {
+            if let Ok(serde_json::Value::Object(fields)) = serde_json::to_value(p) {
+                map.extend(fields);
+            }
+        }
+        v
+    }
+
+    /// Writes the JSON form, pretty-printed, with a final newline.
+    pub fn write_json(&self, w: &mut dyn Write) -> Result<()> {
+        serde_json::to_writer_pretty(&mut *w, &self.to_json_value())?;
+        writeln!(w)?;
+        Ok(())
+    }
+
+    /// Writes CSV, or JSON when `path` ends in `.json`.
+    pub fn write_for(&self, path: &Path, w: &mut dyn Write) -> Result<()> {
+        if path.extension().and_then(|e| e.to_str()) == Some("json") {
+            self.write_json(w)
+        } else {
+            self.write_csv(w)
+        }
+    }
+
+    /// Reads a trace file: eenf JSON, a `time_s,enf_hz` CSV, or (with `index_step_s`) an
+    /// `index,value` CSV whose values are `index_step_s` apart.
+    pub fn read(path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
+        let mut text = String::new();
+        std::fs::File::open(path)
+            .and_then(|mut f| f.read_to_string(&mut text))
+            .with_context(|| format!("{}", path.display()))?;
+        Self::parse(&text, path, index_step_s)
+    }
+
+    /// Parses the text of a trace file named `path` (see [`Trace::read`]).
+    pub fn parse(text: &str, path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
+        let trimmed = text.trim_start();
+        if trimmed.starts_with('{') {
+            return Self::parse_json(trimmed, path);
+        }
+        let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
+        match index_step_s {
+            Some(step) if !header.contains("time_s") => Self::parse_index_csv(text, path, step),
+            _ => Self::parse_csv(text, path),
+        }
+    }
+
+    fn parse_json(text: &str, path: &Path) -> Result<Trace> {
+        let v: serde_json::Value = serde_json::from_str(text)
+            .with_context(|| format!("{}: not valid JSON", path.display()))?;
+        let core: TraceJson = serde_json::from_value(v.clone()).map_err(|e| {
+            anyhow::anyhow!(
+                "{}: not an eenf trace (time_s and enf_hz arrays): {e}",
+                path.display()
+            )
+        })?;
+        if core.time_s.len() != core.enf_hz.len() {
+            bail!("{}: time_s and enf_hz differ in length", path.display());
+        }
+        Ok(Trace {
+            step_s: core.step_s.unwrap_or_else(|| step_of(&core.time_s)),
+            file: core.file,
+            nominal_hz: core.nominal_hz,
+            time_s: core.time_s,
+            enf_hz: core.enf_hz,
+            harmonics: core.harmonics,
+            selected: core.selected,
+            provenance: serde_json::from_value(v).ok(),
+        })
+    }
+
+    fn parse_csv(text: &str, path: &Path) -> Result<Trace> {
+        let body: String = text
+            .lines()
+            .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
+            .flat_map(|l| [l, "\n"])
+            .collect();
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .flexible(true)
+            .from_reader(body.as_bytes());
+        let headers = reader.headers().cloned().unwrap_or_default();
+        let col = |name: &str| headers.iter().position(|h| h == name);
+        let (Some(ti), Some(fi)) = (col("time_s"), col("enf_hz")) else {
+            bail!(
+                "{}: not a trace file (expected a CSV with header {CSV_HEADER:?} or eenf JSON)",
+                path.display()
+            );
+        };
+        let mut trace = Trace {
+            file: Some(path.to_path_buf()),
+            ..Trace::default()
+        };
+        for (n, row) in reader.records().enumerate() {
+            let row = row.with_context(|| format!("{}: line {}", path.display(), n + 2))?;
+            let field = |i: usize| row.get(i).unwrap_or("");
+            let t: f64 = field(ti).parse().with_context(|| {
+                format!(
+                    "{}: line {}: bad time_s {:?}",
+                    path.display(),
+                    n + 2,
+                    field(ti)
+                )
+            })?;
+            let v = match field(fi) {
+                "" => f64::NAN,
+                s => s.parse().with_context(|| {
+                    format!("{}: line {}: bad enf_hz {s:?}", path.display(), n + 2)
+                })?,
+            };
+            trace.time_s.push(t);
+            trace.enf_hz.push(v);
+        }
+        if trace.time_s.is_empty() {
+            bail!("{}: the trace is empty", path.display());
+        }
+        trace.step_s = step_of(&trace.time_s);
+        Ok(trace)
+    }
+
+    fn parse_index_csv(text: &str, path: &Path, step: f64) -> Result<Trace> {
+        // a header row is one whose first field is not a number
+        let skip = usize::from(
+            text.lines()
+                .next()
+                .and_then(|l| l.split(',').next())
+                .is_some_and(|f| f.trim().parse::<f64>().is_err()),
+        );
+        let mut values = Vec::new();
+        for (i, line) in text.lines().enumerate().skip(skip) {
+            if line.trim().is_empty() {
+                continue;
+            }
+            let v = line
+                .split(',')
+                .nth(1)
+                .and_then(|v| v.trim().parse::<f64>().ok())
+                .with_context(|| {
+                    format!("{}: line {}: expected index,value", path.display(), i + 1)
+                })?;
+            values.push(v);
+        }
+        Ok(Trace {
+            file: Some(path.to_path_buf()),
+            ..Trace::new(step, values)
+        })
+    }
+}
+
+/// The step of a trace's times (1 s for a single value).
+fn step_of(t: &[f64]) -> f64 {
+    if t.len() > 1 {
+        t[1] - t[0]
+    } else {
+        1.0
+    }
+}
+
+/// NaN as JSON `null` and back.
+mod nan_as_null {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+        let opt: Vec<Option<f64>> = v.iter().map(|f| f.is_finite().then_some(*f)).collect();
+        opt.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+        let opt: Vec<Option<f64>> = Vec::deserialize(d)?;
+        Ok(opt.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trace_csv_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.csv");
+        let mut buf = Vec::new();
+        Trace::new(1.0, vec![50.01, f64::NAN])
+            .write_csv(&mut buf)
+            .unwrap();
+        std::fs::write(&p, &buf).unwrap();
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert_eq!(text, "time_s,enf_hz\n0,50.01\n1,\n");
+        let t = Trace::read(&p, None).unwrap();
+        assert_eq!(t.time_s, vec![0.0, 1.0]);
+        assert_eq!(t.enf_hz[0], 50.01);
+        assert!(t.enf_hz[1].is_nan());
+        std::fs::write(&p, "a,b\n1,2\n").unwrap();
+        assert!(Trace::read(&p, None).is_err());
+    }
+
+    #[test]
+    fn json_round_trip_keeps_provenance() {
+        let params = EnfParams::default();
+        let t = Trace::from_mains(Path::new("m.wav"), 50.0, &params, vec![50.01, f64::NAN]);
+        let mut buf = Vec::new();
+        t.write_json(&mut buf).unwrap();
+        let back = Trace::parse(std::str::from_utf8(&buf).unwrap(), Path::new("x"), None).unwrap();
+        assert_eq!(back.provenance, t.provenance);
+        assert_eq!(back.peak(), Some(params.peak));
+        assert!(back.enf_hz[1].is_nan());
+    }
+}
