@@ -1,12 +1,11 @@
 //! jAER AEDAT 2.0 and AEDAT 3.1 readers. See `docs/formats.md`.
 
-use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use crate::error::io_err;
 use crate::stream::{read_text_header, Skips, Unwrap, WordDecoder, WordStream};
-use crate::{EventBatch, EventError, EventReader, Result, StreamInfo};
+use crate::{EventBatch, EventError, EventReader, Result, Source, StreamInfo};
 
 /// How a jAER chip packs DVS addresses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -86,7 +85,12 @@ impl WordDecoder for Aedat2 {
 
 /// Opens an AEDAT 2.0 file.
 pub fn open_aedat2(path: &Path) -> Result<Box<dyn EventReader>> {
-    let header = read_text_header(path, b"#", None, "AEDAT 2.0")?;
+    aedat2_from(Box::new(std::fs::File::open(path).map_err(|e| io_err(path, e))?), path)
+}
+
+/// Reads AEDAT 2.0 from `src` (named `path` in errors).
+pub fn aedat2_from(mut src: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventReader>> {
+    let header = read_text_header(src.as_mut(), path, b"#", None, "AEDAT 2.0")?;
     let Some((addressing, w, h, _name)) = chip(&header.lines) else {
         let named = header
             .lines
@@ -108,6 +112,7 @@ pub fn open_aedat2(path: &Path) -> Result<Box<dyn EventReader>> {
         ..StreamInfo::default()
     };
     Ok(Box::new(WordStream::new(
+        src,
         path,
         header.data_start,
         Aedat2 {
@@ -127,7 +132,7 @@ const MAX_PACKET: u64 = 1 << 30;
 /// Reads AEDAT 3.1 packet by packet; polarity packets become events, others are skipped.
 pub struct Aedat31Reader {
     path: PathBuf,
-    file: BufReader<File>,
+    file: BufReader<Box<dyn Source>>,
     pos: u64,
     len: u64,
     info: StreamInfo,
@@ -138,7 +143,12 @@ pub struct Aedat31Reader {
 
 /// Opens an AEDAT 3.1 file.
 pub fn open_aedat31(path: &Path) -> Result<Box<dyn EventReader>> {
-    let header = read_text_header(path, b"#", Some(b"#!END-HEADER"), FORMAT31)?;
+    aedat31_from(Box::new(std::fs::File::open(path).map_err(|e| io_err(path, e))?), path)
+}
+
+/// Reads AEDAT 3.1 from `src` (named `path` in errors).
+pub fn aedat31_from(mut f: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventReader>> {
+    let header = read_text_header(f.as_mut(), path, b"#", Some(b"#!END-HEADER"), FORMAT31)?;
     if !header.lines.iter().any(|l| l.starts_with("!END-HEADER")) {
         return Err(EventError::Truncated {
             path: path.to_path_buf(),
@@ -147,8 +157,7 @@ pub fn open_aedat31(path: &Path) -> Result<Box<dyn EventReader>> {
             reason: "no #!END-HEADER line".into(),
         });
     }
-    let mut f = File::open(path).map_err(|e| io_err(path, e))?;
-    let len = f.metadata().map_err(|e| io_err(path, e))?.len();
+    let len = f.seek(SeekFrom::End(0)).map_err(|e| io_err(path, e))?;
     f.seek(SeekFrom::Start(header.data_start))
         .map_err(|e| io_err(path, e))?;
     // the header names the camera, not its size; sizes come from the data

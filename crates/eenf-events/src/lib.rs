@@ -26,7 +26,7 @@ mod stream;
 pub mod text;
 pub mod writers;
 
-use std::io::Read;
+use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
 pub use aedat4::{Aedat4Reader, Aedat4Writer, Compression};
@@ -103,19 +103,49 @@ pub enum Format {
     Text,
 }
 
-/// Decides the format from the first bytes of the file.
+/// A byte stream a reader can read: a file, a `Cursor<Vec<u8>>`, stdin read into memory.
+pub trait Source: Read + Seek + Send {}
+impl<T: Read + Seek + Send> Source for T {}
+
+/// Bytes looked at to decide a format.
+const HEAD: usize = 4096;
+
+/// What [`probe_source`] found: the format, and the Prophesee `% ` header when it read one
+/// (handed on so that it is read once).
+pub struct Probed {
+    /// The format.
+    pub format: Format,
+    header: Option<stream::TextHeader>,
+}
+
+/// Decides the format of the file at `path` from its first bytes.
 pub fn probe(path: &Path) -> Result<Format> {
     let mut f = std::fs::File::open(path).map_err(|e| error::io_err(path, e))?;
-    let mut head = vec![0u8; 4096];
+    Ok(probe_source(&mut f, path)?.format)
+}
+
+/// Decides the format of `src` (named `path` in errors) from its first bytes; leaves `src`
+/// at its start.
+pub fn probe_source(src: &mut dyn Source, path: &Path) -> Result<Probed> {
+    let mut head = vec![0u8; HEAD];
     let mut n = 0;
     while n < head.len() {
-        match f.read(&mut head[n..]) {
+        match src.read(&mut head[n..]) {
             Ok(0) => break,
             Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
             Err(e) => return Err(error::io_err(path, e)),
         }
     }
     head.truncate(n);
+    src.seek(SeekFrom::Start(0))
+        .map_err(|e| error::io_err(path, e))?;
+    let found = |format| {
+        Ok(Probed {
+            format,
+            header: None,
+        })
+    };
     let unknown = |reason: String| EventError::UnknownFormat {
         path: path.to_path_buf(),
         reason,
@@ -125,32 +155,41 @@ pub fn probe(path: &Path) -> Result<Format> {
         return Err(unknown("the file is empty".into()));
     }
     if head.starts_with(aedat4::MAGIC) {
-        return Ok(Format::Aedat4);
+        return found(Format::Aedat4);
     }
     if head.starts_with(b"#!AER-DAT2.0") {
-        return Ok(Format::Aedat2);
+        return found(Format::Aedat2);
     }
     if head.starts_with(b"#!AER-DAT3") {
-        return Ok(Format::Aedat31);
+        return found(Format::Aedat31);
     }
     if head.starts_with(b"%") {
-        let header = stream::read_text_header(path, b"%", None, "Prophesee")?;
-        if let Some(kind) = prophesee::format_from_header(&header.lines) {
-            return Ok(Format::Prophesee(kind));
-        }
-        // a DAT header may name nothing; its data starts with type 0 and size 8
-        let at = header.data_start as usize;
-        if head.get(at..at + 2) == Some(&[0, 8]) {
-            return Ok(Format::Prophesee(prophesee::ProphFormat::Dat));
-        }
-        return Err(unknown(
-            "a % header that names no EVT encoding or DAT version".into(),
-        ));
+        let header = prophesee::read_header(src, path)?;
+        src.seek(SeekFrom::Start(0))
+            .map_err(|e| error::io_err(path, e))?;
+        let format = match prophesee::format_from_header(&header.lines) {
+            Some(kind) => kind,
+            // a DAT header may name nothing; its data starts with type 0 and size 8
+            None if head.get(header.data_start as usize..header.data_start as usize + 2)
+                == Some(&[0, 8]) =>
+            {
+                prophesee::ProphFormat::Dat
+            }
+            None => {
+                return Err(unknown(
+                    "a % header that names no EVT encoding or DAT version".into(),
+                ))
+            }
+        };
+        return Ok(Probed {
+            format: Format::Prophesee(format),
+            header: Some(header),
+        });
     }
     // Text: the first event line (after comments) holds four numbers. Judge only complete lines.
     let text = String::from_utf8_lossy(&head);
     let complete = match text.rfind('\n') {
-        Some(i) if n == 4096 => &text[..i],
+        Some(i) if n == HEAD => &text[..i],
         _ => &text[..],
     };
     if !head.contains(&0) {
@@ -165,7 +204,7 @@ pub fn probe(path: &Path) -> Result<Format> {
                 continue;
             }
             if text::looks_like_event_line(l) {
-                return Ok(Format::Text);
+                return found(Format::Text);
             }
             break;
         }
@@ -178,12 +217,26 @@ pub fn probe(path: &Path) -> Result<Format> {
 
 /// Opens an event file with the reader its content calls for.
 pub fn open(path: &Path) -> Result<Box<dyn EventReader>> {
-    Ok(match probe(path)? {
-        Format::Aedat4 => Box::new(Aedat4Reader::open(path)?),
-        Format::Prophesee(_) => prophesee::open(path)?,
-        Format::Aedat2 => jaer::open_aedat2(path)?,
-        Format::Aedat31 => jaer::open_aedat31(path)?,
-        Format::Text => Box::new(TextReader::open(path)?),
+    let f = std::fs::File::open(path).map_err(|e| error::io_err(path, e))?;
+    open_source(Box::new(f), path)
+}
+
+/// The reader that the content of `src` (named `path` in errors) calls for. The head is read
+/// once, and the same stream is handed to the reader.
+pub fn open_source(mut src: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventReader>> {
+    let probed = probe_source(src.as_mut(), path)?;
+    Ok(match probed.format {
+        Format::Aedat4 => Box::new(Aedat4Reader::new(src, path)?),
+        Format::Prophesee(kind) => {
+            let header = match probed.header {
+                Some(header) => header,
+                None => prophesee::read_header(src.as_mut(), path)?,
+            };
+            prophesee::from_header(src, path, header, kind)?
+        }
+        Format::Aedat2 => jaer::aedat2_from(src, path)?,
+        Format::Aedat31 => jaer::aedat31_from(src, path)?,
+        Format::Text => Box::new(TextReader::new(src, path)?),
     })
 }
 

@@ -2,10 +2,8 @@
 
 use std::path::Path;
 
-use crate::stream::{
-    prophesee_geometry, read_text_header, time_offset, Skips, Unwrap, WordDecoder, WordStream,
-};
-use crate::{EventBatch, EventError, EventReader, Result, StreamInfo};
+use crate::stream::{read_text_header, Skips, TextHeader, Unwrap, WordDecoder, WordStream};
+use crate::{EventBatch, EventError, EventReader, Result, Source, StreamInfo};
 
 /// Which Prophesee encoding a file uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -68,7 +66,9 @@ fn header_info(lines: &[String], format: &'static str) -> StreamInfo {
 
 /// Opens a Prophesee RAW or DAT file (the encoding is read from its header).
 pub fn open(path: &Path) -> Result<Box<dyn EventReader>> {
-    let header = read_text_header(path, b"%", None, "Prophesee")?;
+    let mut src: Box<dyn Source> =
+        Box::new(std::fs::File::open(path).map_err(|e| crate::error::io_err(path, e))?);
+    let header = read_text_header(src.as_mut(), path, b"%", None, "Prophesee")?;
     let Some(kind) = format_from_header(&header.lines) else {
         return Err(EventError::UnknownFormat {
             path: path.to_path_buf(),
@@ -76,40 +76,39 @@ pub fn open(path: &Path) -> Result<Box<dyn EventReader>> {
             supported: crate::SUPPORTED,
         });
     };
+    from_header(src, path, header, kind)
+}
+
+/// The `% ` header at the top of `src`, which names the encoding.
+pub(crate) fn read_header(src: &mut dyn Source, path: &Path) -> Result<TextHeader> {
+    read_text_header(src, path, b"%", None, "Prophesee")
+}
+
+/// The `kind` reader of `src` (named `path` in errors) whose `% ` header has been read.
+pub(crate) fn from_header(
+    src: Box<dyn Source>,
+    path: &Path,
+    header: TextHeader,
+    kind: ProphFormat,
+) -> Result<Box<dyn EventReader>> {
     let start = header.data_start;
     let offset = time_offset(&header.lines);
+    let info = |name| header_info(&header.lines, name);
     Ok(match kind {
         ProphFormat::Evt2 => Box::new(
-            WordStream::new(
-                path,
-                start,
-                Evt2::default(),
-                header_info(&header.lines, "EVT 2.0"),
-            )?
-            .with_offset(offset),
+            WordStream::new(src, path, start, Evt2::default(), info("EVT 2.0"))?.with_offset(offset),
         ),
-        ProphFormat::Evt21 { legacy } => Box::new(
-            WordStream::new(
-                path,
-                start,
-                Evt21 {
-                    legacy,
-                    ..Evt21::default()
-                },
-                header_info(&header.lines, "EVT 2.1"),
-            )?
-            .with_offset(offset),
-        ),
+        ProphFormat::Evt21 { legacy } => {
+            let dec = Evt21 {
+                legacy,
+                ..Evt21::default()
+            };
+            Box::new(WordStream::new(src, path, start, dec, info("EVT 2.1"))?.with_offset(offset))
+        }
         ProphFormat::Evt3 => Box::new(
-            WordStream::new(
-                path,
-                start,
-                Evt3::default(),
-                header_info(&header.lines, "EVT 3.0"),
-            )?
-            .with_offset(offset),
+            WordStream::new(src, path, start, Evt3::default(), info("EVT 3.0"))?.with_offset(offset),
         ),
-        ProphFormat::Dat => open_dat(path, start, &header.lines)?,
+        ProphFormat::Dat => open_dat(src, path, start, &header.lines)?,
     })
 }
 
@@ -308,9 +307,13 @@ impl WordDecoder for Dat {
     }
 }
 
-fn open_dat(path: &Path, start: u64, lines: &[String]) -> Result<Box<dyn EventReader>> {
+fn open_dat(
+    mut f: Box<dyn Source>,
+    path: &Path,
+    start: u64,
+    lines: &[String],
+) -> Result<Box<dyn EventReader>> {
     use std::io::{Read, Seek, SeekFrom};
-    let mut f = std::fs::File::open(path).map_err(|e| crate::error::io_err(path, e))?;
     f.seek(SeekFrom::Start(start))
         .map_err(|e| crate::error::io_err(path, e))?;
     let mut ts = [0u8; 2];
@@ -333,6 +336,7 @@ fn open_dat(path: &Path, start: u64, lines: &[String]) -> Result<Box<dyn EventRe
     }
     Ok(Box::new(
         WordStream::new(
+            f,
             path,
             start + 2,
             Dat {
@@ -342,4 +346,80 @@ fn open_dat(path: &Path, start: u64, lines: &[String]) -> Result<Box<dyn EventRe
         )?
         .with_offset(time_offset(lines)),
     ))
+}
+
+/// Resolution from a Prophesee header: `% format …;height=H;width=W`, `% geometry WxH`,
+/// `% Width W` / `% Height H`, or the sensor generation in `% plugin_name`.
+fn prophesee_geometry(lines: &[String]) -> (Option<u16>, Option<u16>) {
+    let (mut w, mut h) = (None, None);
+    for l in lines {
+        let lower = l.to_ascii_lowercase();
+        if let Some(rest) = lower.strip_prefix("format ") {
+            for opt in rest.split(';') {
+                if let Some(v) = opt.trim().strip_prefix("width=") {
+                    w = v.trim().parse().ok().or(w);
+                }
+                if let Some(v) = opt.trim().strip_prefix("height=") {
+                    h = v.trim().parse().ok().or(h);
+                }
+            }
+        } else if let Some(rest) = lower.strip_prefix("geometry ") {
+            if let Some((a, b)) = rest.trim().split_once('x') {
+                w = a.trim().parse().ok().or(w);
+                h = b.trim().parse().ok().or(h);
+            }
+        } else if let Some(v) = lower.strip_prefix("width ") {
+            w = v.trim().parse().ok().or(w);
+        } else if let Some(v) = lower.strip_prefix("height ") {
+            h = v.trim().parse().ok().or(h);
+        }
+    }
+    if w.is_none() || h.is_none() {
+        let plugin = lines
+            .iter()
+            .find_map(|l| {
+                l.to_ascii_lowercase()
+                    .strip_prefix("plugin_name ")
+                    .map(str::to_string)
+            })
+            .unwrap_or_default();
+        let guess =
+            if plugin.contains("gen41") || plugin.contains("imx636") || plugin.contains("gen4") {
+                Some((1280, 720))
+            } else if plugin.contains("gen3") {
+                Some((640, 480))
+            } else if plugin.contains("imx8") || plugin.contains("genx320") {
+                Some((320, 320))
+            } else {
+                None
+            };
+        if let Some((gw, gh)) = guess {
+            w = w.or(Some(gw));
+            h = h.or(Some(gh));
+        }
+    }
+    (w, h)
+}
+
+/// The `% eenf_time_offset_us N` header line written by eenf for clocks too narrow for
+/// absolute time.
+fn time_offset(lines: &[String]) -> i64 {
+    lines
+        .iter()
+        .find_map(|l| l.strip_prefix("eenf_time_offset_us "))
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(0)
+}
+
+impl Skips {
+    /// Counts a Prophesee word type that is not an event or a time word: 0xA external
+    /// trigger, 0xE/0xF others and continuations, anything else unknown.
+    fn count_prophesee(&mut self, kind: u64) {
+        match kind {
+            0xA => self.triggers += 1,
+            0xE | 0xF => self.other += 1,
+            _ => self.unknown += 1,
+        }
+    }
+
 }

@@ -1,10 +1,10 @@
-//! Shared plumbing of the word-oriented readers: text headers and chunked reading of whole words
-//! with constant memory.
+//! Shared plumbing of the word readers (Prophesee and jAER): text headers (`%`, `#`), chunked
+//! reading of whole words with constant memory over any byte [`Source`], skip counts and
+//! counter unwrapping.
 
-use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};
 
-use crate::{EventBatch, EventReader, StreamInfo};
+use crate::{EventBatch, EventReader, Source, StreamInfo};
 use std::path::{Path, PathBuf};
 
 use crate::error::{io_err, EventError, Result};
@@ -20,16 +20,17 @@ pub(crate) struct TextHeader {
     pub data_start: u64,
 }
 
-/// Reads the lines that start with `prefix` at the top of a file. `end_marker`, when given,
-/// is a line that ends the header (and belongs to it).
+/// Reads the lines that start with `prefix` at the top of `src` (named `path` in errors).
+/// `end_marker`, when given, is a line that ends the header (and belongs to it).
 pub(crate) fn read_text_header(
+    src: &mut dyn Source,
     path: &Path,
     prefix: &[u8],
     end_marker: Option<&[u8]>,
     format: &'static str,
 ) -> Result<TextHeader> {
-    let f = File::open(path).map_err(|e| io_err(path, e))?;
-    let mut r = BufReader::new(f);
+    src.seek(SeekFrom::Start(0)).map_err(|e| io_err(path, e))?;
+    let mut r = BufReader::new(src);
     let mut lines = Vec::new();
     let mut pos = 0u64;
     let mut line = Vec::new();
@@ -81,7 +82,7 @@ pub(crate) fn read_text_header(
 /// Reads a file from an offset in chunks that hold whole words of `word` bytes.
 pub(crate) struct WordReader {
     pub path: PathBuf,
-    file: File,
+    file: Box<dyn Source>,
     buf: Vec<u8>,
     /// Unconsumed bytes are `buf[start..end]`.
     start: usize,
@@ -97,8 +98,13 @@ pub(crate) struct WordReader {
 }
 
 impl WordReader {
-    pub(crate) fn open(path: &Path, start: u64, word: usize, format: &'static str) -> Result<Self> {
-        let mut file = File::open(path).map_err(|e| io_err(path, e))?;
+    pub(crate) fn new(
+        mut file: Box<dyn Source>,
+        path: &Path,
+        start: u64,
+        word: usize,
+        format: &'static str,
+    ) -> Result<Self> {
         file.seek(SeekFrom::Start(start))
             .map_err(|e| io_err(path, e))?;
         Ok(WordReader {
@@ -161,59 +167,6 @@ impl WordReader {
     }
 }
 
-/// Resolution from a Prophesee header: `% format …;height=H;width=W`, `% geometry WxH`,
-/// `% Width W` / `% Height H`, or the sensor generation in `% plugin_name`.
-pub(crate) fn prophesee_geometry(lines: &[String]) -> (Option<u16>, Option<u16>) {
-    let (mut w, mut h) = (None, None);
-    for l in lines {
-        let lower = l.to_ascii_lowercase();
-        if let Some(rest) = lower.strip_prefix("format ") {
-            for opt in rest.split(';') {
-                if let Some(v) = opt.trim().strip_prefix("width=") {
-                    w = v.trim().parse().ok().or(w);
-                }
-                if let Some(v) = opt.trim().strip_prefix("height=") {
-                    h = v.trim().parse().ok().or(h);
-                }
-            }
-        } else if let Some(rest) = lower.strip_prefix("geometry ") {
-            if let Some((a, b)) = rest.trim().split_once('x') {
-                w = a.trim().parse().ok().or(w);
-                h = b.trim().parse().ok().or(h);
-            }
-        } else if let Some(v) = lower.strip_prefix("width ") {
-            w = v.trim().parse().ok().or(w);
-        } else if let Some(v) = lower.strip_prefix("height ") {
-            h = v.trim().parse().ok().or(h);
-        }
-    }
-    if w.is_none() || h.is_none() {
-        let plugin = lines
-            .iter()
-            .find_map(|l| {
-                l.to_ascii_lowercase()
-                    .strip_prefix("plugin_name ")
-                    .map(str::to_string)
-            })
-            .unwrap_or_default();
-        let guess =
-            if plugin.contains("gen41") || plugin.contains("imx636") || plugin.contains("gen4") {
-                Some((1280, 720))
-            } else if plugin.contains("gen3") {
-                Some((640, 480))
-            } else if plugin.contains("imx8") || plugin.contains("genx320") {
-                Some((320, 320))
-            } else {
-                None
-            };
-        if let Some((gw, gh)) = guess {
-            w = w.or(Some(gw));
-            h = h.or(Some(gh));
-        }
-    }
-    (w, h)
-}
-
 /// Turns chunks of whole words into events, keeping the format's state between chunks.
 pub(crate) trait WordDecoder: Send {
     /// Bytes per word.
@@ -235,9 +188,15 @@ pub(crate) struct WordStream<D: WordDecoder> {
 }
 
 impl<D: WordDecoder> WordStream<D> {
-    pub(crate) fn new(path: &Path, start: u64, decoder: D, info: StreamInfo) -> Result<Self> {
+    pub(crate) fn new(
+        src: Box<dyn Source>,
+        path: &Path,
+        start: u64,
+        decoder: D,
+        info: StreamInfo,
+    ) -> Result<Self> {
         Ok(WordStream {
-            words: WordReader::open(path, start, D::WORD, info.format)?,
+            words: WordReader::new(src, path, start, D::WORD, info.format)?,
             decoder,
             format: info.format,
             info,
@@ -250,16 +209,6 @@ impl<D: WordDecoder> WordStream<D> {
         self.offset = offset;
         self
     }
-}
-
-/// The `% eenf_time_offset_us N` header line written by eenf for clocks too narrow for
-/// absolute time.
-pub(crate) fn time_offset(lines: &[String]) -> i64 {
-    lines
-        .iter()
-        .find_map(|l| l.strip_prefix("eenf_time_offset_us "))
-        .and_then(|v| v.trim().parse().ok())
-        .unwrap_or(0)
 }
 
 impl<D: WordDecoder> EventReader for WordStream<D> {
@@ -305,16 +254,6 @@ pub(crate) struct Skips {
 }
 
 impl Skips {
-    /// Counts a Prophesee word type that is not an event or a time word: 0xA external
-    /// trigger, 0xE/0xF others and continuations, anything else unknown.
-    pub(crate) fn count_prophesee(&mut self, kind: u64) {
-        match kind {
-            0xA => self.triggers += 1,
-            0xE | 0xF => self.other += 1,
-            _ => self.unknown += 1,
-        }
-    }
-
     pub(crate) fn list(&self) -> Vec<(&'static str, u64)> {
         [
             ("trigger", self.triggers),

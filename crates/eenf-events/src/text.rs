@@ -5,11 +5,11 @@
 //! polarity 0/1 or -1/+1.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use crate::error::{io_err, EventError, Result};
-use crate::{EventBatch, EventReader, StreamInfo};
+use crate::{EventBatch, EventReader, Source, StreamInfo};
 
 const FORMAT: &str = "text";
 const BATCH: usize = 1 << 16;
@@ -101,7 +101,7 @@ fn parse_line(
 /// Streams events from a text file.
 pub struct TextReader {
     path: PathBuf,
-    lines: std::io::Lines<BufReader<File>>,
+    lines: std::io::Lines<BufReader<Box<dyn Source>>>,
     line_no: u64,
     unit: TimeUnit,
     info: StreamInfo,
@@ -112,9 +112,14 @@ pub struct TextReader {
 impl TextReader {
     /// Opens a text event file; the time unit is decided from the first event line.
     pub fn open(path: &Path) -> Result<Self> {
-        let f = File::open(path).map_err(|e| io_err(path, e))?;
+        Self::new(Box::new(File::open(path).map_err(|e| io_err(path, e))?), path)
+    }
+
+    /// Reads text events from `f` (named `path` in errors).
+    pub fn new(mut f: Box<dyn Source>, path: &Path) -> Result<Self> {
         let mut unit = TimeUnit::Micros;
-        for line in BufReader::new(f).lines().take(10_000) {
+        f.seek(SeekFrom::Start(0)).map_err(|e| io_err(path, e))?;
+        for line in BufReader::new(&mut f).lines().take(10_000) {
             let line = line.map_err(|e| io_err(path, e))?;
             if is_column_names(&line) {
                 continue;
@@ -127,7 +132,7 @@ impl TextReader {
                 break;
             }
         }
-        let f = File::open(path).map_err(|e| io_err(path, e))?;
+        f.seek(SeekFrom::Start(0)).map_err(|e| io_err(path, e))?;
         Ok(TextReader {
             path: path.to_path_buf(),
             lines: BufReader::with_capacity(1 << 20, f).lines(),

@@ -146,3 +146,34 @@ fn truncated_and_flipped_files_never_panic() {
         }
     }
 }
+
+/// A writer into any seekable sink, and the readers over any byte source, give what the file
+/// paths give: bytes in memory decode to the same events as the file.
+#[test]
+fn writers_and_readers_work_over_bytes_in_memory() {
+    use std::io::{Cursor, Read, Seek, SeekFrom};
+    let dir = tempfile::tempdir().unwrap();
+    let events = sample(12_000, 1_700_000_000_123_456);
+    for (k, (format, ext)) in formats().into_iter().enumerate() {
+        let path = dir.path().join(format!("mem{k}.{ext}"));
+        // the same events through a temporary file handed over as a sink
+        let mut file = tempfile::tempfile().unwrap();
+        let sink = Box::new(file.try_clone().unwrap());
+        let name = std::path::Path::new("in-memory");
+        let mut w = eenf_events::writers::writer(sink, name, format, 640, 480).unwrap();
+        w.write(&events).unwrap();
+        w.finish().unwrap();
+        let mut bytes = Vec::new();
+        file.seek(SeekFrom::Start(0)).unwrap();
+        file.read_to_end(&mut bytes).unwrap();
+        std::fs::write(&path, &bytes).unwrap();
+        let from_file = read_all(&path);
+        let mut r = eenf_events::open_source(Box::new(Cursor::new(bytes)), name).unwrap();
+        let mut from_bytes = EventBatch::default();
+        while let Some(b) = r.next_batch().unwrap() {
+            from_bytes.extend_from(&b);
+        }
+        assert_eq!(from_bytes, from_file, "{format}");
+        assert_eq!(canonical(&from_file), canonical(&events), "{format}");
+    }
+}

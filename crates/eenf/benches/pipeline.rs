@@ -78,7 +78,7 @@ fn benches(c: &mut Criterion) {
         OutputFormat::Dat,
     ] {
         let (path, n) = fixture(seconds, format);
-        let mut g = c.benchmark_group(format.name().replace(' ', "_"));
+        let mut g = c.benchmark_group(format.to_string().replace(' ', "_"));
         g.sample_size(10);
         g.throughput(Throughput::Elements(n));
         g.bench_function("decode", |b| {

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use crate::error::{io_err, EventError, Result};
-use crate::{EventBatch, EventReader, StreamDesc, StreamInfo};
+use crate::{EventBatch, EventReader, Source, StreamDesc, StreamInfo};
 use flatbuf::Table;
 pub use writer::Aedat4Writer;
 
@@ -249,7 +249,7 @@ struct TableSummary {
 /// Reads an AEDAT 4.0 file packet by packet; memory is bounded by a few packets.
 pub struct Aedat4Reader {
     path: PathBuf,
-    file: BufReader<File>,
+    file: BufReader<Box<dyn Source>>,
     pos: u64,
     end: u64,
     codec: Compression,
@@ -278,9 +278,15 @@ struct Slot {
 impl Aedat4Reader {
     /// Opens the file and reads its header (and FileDataTable, when present).
     pub fn open(path: &Path) -> Result<Self> {
-        let file = File::open(path).map_err(|e| io_err(path, e))?;
-        let file_len = file.metadata().map_err(|e| io_err(path, e))?.len();
-        let mut file = BufReader::with_capacity(1 << 20, file);
+        Self::new(Box::new(File::open(path).map_err(|e| io_err(path, e))?), path)
+    }
+
+    /// Reads AEDAT 4.0 from `src` (named `path` in errors): its header, and its FileDataTable
+    /// when present.
+    pub fn new(mut src: Box<dyn Source>, path: &Path) -> Result<Self> {
+        let file_len = src.seek(SeekFrom::End(0)).map_err(|e| io_err(path, e))?;
+        src.seek(SeekFrom::Start(0)).map_err(|e| io_err(path, e))?;
+        let mut file = BufReader::with_capacity(1 << 20, src);
         let trunc = |offset: u64, reason: &str| EventError::Truncated {
             path: path.to_path_buf(),
             format: FORMAT,
@@ -518,7 +524,7 @@ fn read_exact_or(
 }
 
 fn read_table(
-    file: &mut BufReader<File>,
+    file: &mut BufReader<Box<dyn Source>>,
     pos: u64,
     file_len: u64,
     codec: Compression,
