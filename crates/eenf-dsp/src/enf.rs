@@ -109,6 +109,8 @@ pub struct HarmonicEstimates {
     pub center_hz: f64,
     /// ENF estimates (divided by 2m), after outlier correction.
     pub enf_hz: Vec<f64>,
+    /// Each window's line strength over the band's noise, dB.
+    pub snr_db: Vec<f64>,
 }
 
 /// An ENF trace and how it was assembled.
@@ -118,6 +120,8 @@ pub struct EnfEstimates {
     pub step_s: f64,
     /// The ENF, Hz.
     pub enf_hz: Vec<f64>,
+    /// The line strength over its noise of each estimate (of the band selected there), dB.
+    pub snr_db: Vec<f64>,
     /// Per-harmonic traces.
     pub harmonics: Vec<HarmonicEstimates>,
     /// Harmonic number chosen in each segment.
@@ -159,9 +163,9 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimate
             let band = (center - p.half_band_hz, center + p.half_band_hz);
             let sos = butter_bandpass(p.filter_order, band.0, band.1, fs);
             let y = sosfiltfilt(&sos, x);
-            let raw = tracker.track(&y, band);
+            let tracked = tracker.track_with_snr(&y, band);
             // correct outliers on the 2f0 scale, report on the f_e scale
-            let on_2f0: Vec<f64> = raw.iter().map(|f| f / m as f64).collect();
+            let on_2f0: Vec<f64> = tracked.iter().map(|(f, _)| f / m as f64).collect();
             let corrected = if p.median_len > 1 {
                 median_correct(&on_2f0, p.median_len, p.median_threshold_hz)
             } else {
@@ -171,21 +175,68 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimate
                 harmonic: m,
                 center_hz: center,
                 enf_hz: corrected.iter().map(|f| f / 2.0).collect(),
+                snr_db: tracked.iter().map(|(_, s)| *s).collect(),
             }
         })
         .collect();
-    let traces: Vec<Vec<f64>> = harmonics.iter().map(|h| h.enf_hz.clone()).collect();
+    let traces = audible(&harmonics, p.segment_len);
     let (enf_hz, chosen) = select_harmonics(&traces, p.segment_len, p.selection);
     if enf_hz.iter().all(|v| !v.is_finite()) {
         return Err(DspError::NoTone("the flicker bands hold no signal".into()));
     }
+    let seg = p.segment_len.max(1);
+    let snr_db = (0..enf_hz.len())
+        .map(|i| {
+            harmonics[chosen[i / seg]]
+                .snr_db
+                .get(i)
+                .copied()
+                .unwrap_or(f64::NAN)
+        })
+        .collect();
     Ok(EnfEstimates {
         step_s: p.step_s,
         enf_hz,
+        snr_db,
         selected: chosen.iter().map(|&i| harmonics[i].harmonic).collect(),
         harmonics,
         segment_len: p.segment_len,
     })
+}
+
+/// A band's line must stand this far above its noise (mean over a selection segment, dB) for
+/// the selection to take it there. Noise alone peaks at about 8 dB over the band's median.
+pub const MIN_BAND_SNR_DB: f64 = 12.0;
+
+/// The harmonic traces as the selection may use them: in each segment, a band whose line does
+/// not stand [`MIN_BAND_SNR_DB`] above its noise is blanked (NaN), unless no band does, when
+/// only the strongest is kept.
+fn audible(harmonics: &[HarmonicEstimates], segment: usize) -> Vec<Vec<f64>> {
+    let mut traces: Vec<Vec<f64>> = harmonics.iter().map(|h| h.enf_hz.clone()).collect();
+    let n = traces.iter().map(|t| t.len()).min().unwrap_or(0);
+    for start in (0..n).step_by(segment.max(1)) {
+        let end = (start + segment.max(1)).min(n);
+        let mean: Vec<f64> = harmonics
+            .iter()
+            .map(|h| {
+                let v: Vec<f64> = h.snr_db[start..end]
+                    .iter()
+                    .copied()
+                    .filter(|s| s.is_finite())
+                    .collect();
+                v.iter().sum::<f64>() / v.len().max(1) as f64
+            })
+            .collect();
+        let best = (0..mean.len())
+            .max_by(|&a, &b| mean[a].total_cmp(&mean[b]))
+            .unwrap_or(0);
+        for (k, t) in traces.iter_mut().enumerate() {
+            if mean[k] < MIN_BAND_SNR_DB && k != best {
+                t[start..end].iter_mut().for_each(|v| *v = f64::NAN);
+            }
+        }
+    }
+    traces
 }
 
 /// The reference ENF of a mains (or audio) signal: the same tracker at the fundamental f0,

@@ -20,6 +20,7 @@
 pub mod butter;
 pub mod enf;
 pub mod filtfilt;
+pub mod flicker;
 pub mod matching;
 pub mod metrics;
 pub mod postprocess;
@@ -30,11 +31,12 @@ pub mod tracker;
 pub use butter::{butter_bandpass, sos_to_ba, Section};
 pub use enf::{
     check_line, detect_nominal, enf_from_flicker, extract_enf, line_prominence, reference_enf,
-    DspError, EnfParams, EnfEstimates, HarmonicEstimates,
+    DspError, EnfEstimates, EnfParams, HarmonicEstimates,
 };
 pub use filtfilt::sosfiltfilt;
+pub use flicker::{flicker_line, flicker_lines, FlickerLine, MIN_FLICKER_PROMINENCE};
 pub use metrics::{agreement, Agreement};
 pub use postprocess::{median_correct, select_harmonics, HarmonicSelection};
-pub use sampling::{PolaritySequence, SamplingError, SamplingMethod, TemporalSampler};
+pub use sampling::{Grouping, PolaritySequence, SamplingError, SamplingMethod, TemporalSampler};
 pub use spectrogram::{spectrogram, Spectrogram};
 pub use tracker::{PeakMethod, StftTracker};

@@ -1,5 +1,6 @@
-//! Uniform-interval temporal sampling of an event stream into a polarity sequence
-//! E(n) ∈ {−1, 0, +1} (majority vote of the polarities in each sample).
+//! Uniform-interval temporal sampling of an event stream into a flicker signal: the paper's
+//! polarity sequence E(n) ∈ {−1, 0, +1} (majority vote of the polarities in each sample), or
+//! the signed count ON − OFF of every event in each bin for sensors that stamp events one by one.
 
 use eenf_events::EventBatch;
 
@@ -14,16 +15,85 @@ pub enum SamplingMethod {
     Authors,
     /// The journal version: vote over all events in [t_n, t_n + Δt).
     Block,
+    /// ON − OFF count of all events in [t_n, t_n + Δt): every event counts, as sensors that
+    /// stamp events one by one (DVS128, DAVIS, Prophesee) need.
+    Sum,
+    /// Chooses from the stream: `paper` when events come in scan groups that share a timestamp
+    /// (DVXplorer), `sum` otherwise. See [`Grouping`].
+    Auto,
 }
 
 impl SamplingMethod {
     /// Every variant, by its command-line name.
-    pub const NAMES: [&'static str; 3] = ["paper", "authors", "block"];
-    const ALL: [SamplingMethod; 3] = [
+    pub const NAMES: [&'static str; 5] = ["paper", "authors", "block", "sum", "auto"];
+    const ALL: [SamplingMethod; 5] = [
         SamplingMethod::Paper,
         SamplingMethod::Authors,
         SamplingMethod::Block,
+        SamplingMethod::Sum,
+        SamplingMethod::Auto,
     ];
+}
+
+/// How a stream's timestamps group, measured on its first events: what `auto` sampling goes by.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Grouping {
+    /// Events looked at.
+    pub events: usize,
+    /// Mean events per distinct timestamp.
+    pub events_per_timestamp: f64,
+    /// Median step between distinct timestamps, µs.
+    pub median_step_us: f64,
+}
+
+impl Grouping {
+    /// Events looked at to decide.
+    pub const SAMPLE: usize = 100_000;
+
+    /// Measures the first [`Grouping::SAMPLE`] timestamps (in time order).
+    pub fn measure(t: &[i64]) -> Self {
+        let t = &t[..t.len().min(Self::SAMPLE)];
+        let mut steps: Vec<i64> = t
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .filter(|&d| d > 0)
+            .collect();
+        let distinct = steps.len() + usize::from(!t.is_empty());
+        let median = if steps.is_empty() {
+            0.0
+        } else {
+            let k = steps.len() / 2;
+            *steps.select_nth_unstable(k).1 as f64
+        };
+        Grouping {
+            events: t.len(),
+            events_per_timestamp: t.len() as f64 / distinct.max(1) as f64,
+            median_step_us: median,
+        }
+    }
+
+    /// Scan groups: several events per timestamp, and timestamps a scan apart (a DVXplorer
+    /// reads its array every ~200 µs). Dense µs-stamped streams share timestamps too, but 1 µs
+    /// apart; sparse ones neither.
+    pub fn is_scanned(&self) -> bool {
+        self.events_per_timestamp >= 8.0 && self.median_step_us >= 20.0
+    }
+
+    /// The sampling `auto` picks, and why, in words.
+    pub fn choice(&self) -> (SamplingMethod, String) {
+        let measured = format!(
+            "{:.1} events per timestamp, timestamps {:.0} µs apart (median) in the first {} events",
+            self.events_per_timestamp, self.median_step_us, self.events
+        );
+        if self.is_scanned() {
+            (SamplingMethod::Paper, format!("scan groups: {measured}"))
+        } else {
+            (
+                SamplingMethod::Sum,
+                format!("events stamped one by one: {measured}"),
+            )
+        }
+    }
 }
 
 impl std::fmt::Display for SamplingMethod {
@@ -41,15 +111,19 @@ impl std::str::FromStr for SamplingMethod {
     }
 }
 
-/// The sampled polarity sequence.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// The sampled flicker signal.
+#[derive(Debug, Clone, PartialEq)]
 pub struct PolaritySequence {
     /// Time of sample 0 (the first event), µs.
     pub t0_us: i64,
     /// Sampling interval, µs.
     pub dt_us: i64,
-    /// E(n) ∈ {−1, 0, +1}.
-    pub values: Vec<i8>,
+    /// E(n) ∈ {−1, 0, +1} (the votes), or ON − OFF per bin (`sum`).
+    pub values: Vec<f32>,
+    /// The sampling used (`auto` resolved).
+    pub method: SamplingMethod,
+    /// Why, when `auto` chose it.
+    pub reason: Option<String>,
 }
 
 impl PolaritySequence {
@@ -86,8 +160,9 @@ pub struct TemporalSampler {
     values: Vec<i8>,
     /// Paper: the group at the end of the last batch, which may continue in the next one.
     carry: Option<(i64, i64)>,
-    /// Block: ON − OFF per bin; Authors: the current group's (time, bin, ON − OFF).
+    /// Block and Sum: ON − OFF per bin; Authors: the current group's (time, bin, ON − OFF).
     counts: Vec<i32>,
+    reason: Option<String>,
     group: Option<(i64, usize, i64)>,
     max_samples: usize,
     events: u64,
@@ -111,7 +186,13 @@ impl TemporalSampler {
             group: None,
             max_samples: (48 * 3600 * 1_000_000 / dt_us) as usize,
             events: 0,
+            reason: None,
         }
+    }
+
+    /// The sampling in use: `auto` stays `auto` until the first events decide it.
+    pub fn method(&self) -> SamplingMethod {
+        self.method
     }
 
     /// Events seen so far.
@@ -137,10 +218,17 @@ impl TemporalSampler {
         }
         self.events += batch.len() as u64;
         let t0 = *self.t0.get_or_insert(batch.t[0]);
+        if self.method == SamplingMethod::Auto {
+            let (method, reason) = Grouping::measure(&batch.t).choice();
+            self.method = method;
+            self.reason = Some(reason);
+        }
         match self.method {
             SamplingMethod::Paper => self.push_paper(batch, t0),
             SamplingMethod::Authors => self.push_authors(batch, t0),
-            SamplingMethod::Block => self.push_block(batch, t0),
+            SamplingMethod::Block | SamplingMethod::Sum | SamplingMethod::Auto => {
+                self.push_block(batch, t0)
+            }
         }
     }
 
@@ -258,11 +346,22 @@ impl TemporalSampler {
             SamplingMethod::Block => {
                 self.values = self.counts.iter().map(|&c| c.signum() as i8).collect();
             }
+            SamplingMethod::Sum | SamplingMethod::Auto => {
+                return Ok(PolaritySequence {
+                    t0_us: t0,
+                    dt_us: self.dt,
+                    values: self.counts.iter().map(|&c| c as f32).collect(),
+                    method: SamplingMethod::Sum,
+                    reason: self.reason,
+                });
+            }
         }
         Ok(PolaritySequence {
             t0_us: t0,
             dt_us: self.dt,
-            values: self.values,
+            values: self.values.iter().map(|&v| v as f32).collect(),
+            method: self.method,
+            reason: self.reason,
         })
     }
 }
@@ -284,7 +383,12 @@ mod tests {
         for p in parts {
             s.push(&batch(p)).unwrap();
         }
-        s.finish().unwrap().values
+        s.finish()
+            .unwrap()
+            .values
+            .iter()
+            .map(|&v| v as i8)
+            .collect()
     }
 
     // events: t=0 (+,+,-), t=400 (-), t=2500 (-,-), t=2600 (+), t=3000 (+)
@@ -325,6 +429,7 @@ mod tests {
             SamplingMethod::Paper,
             SamplingMethod::Authors,
             SamplingMethod::Block,
+            SamplingMethod::Sum,
         ] {
             let whole = run(method, &[EV]);
             for cut in 1..EV.len() {
@@ -345,5 +450,42 @@ mod tests {
         let mut s = TemporalSampler::new(SamplingMethod::Block, 1000);
         let e = s.push(&batch(&[(0, true), (i64::MAX / 2, true)]));
         assert!(e.is_err());
+    }
+
+    #[test]
+    fn sum_counts_every_event() {
+        let ev = [(0, true), (0, true), (0, true), (500, false), (1500, true)];
+        assert_eq!(run(SamplingMethod::Sum, &[&ev]), vec![2, 1]);
+        // the vote of the same bins is only their sign
+        assert_eq!(run(SamplingMethod::Block, &[&ev]), vec![1, 1]);
+    }
+
+    #[test]
+    fn auto_samples_scan_groups_as_the_paper_and_single_stamps_as_a_sum() {
+        let stream = |groups: usize, per: usize, step: i64| {
+            let mut b = EventBatch::default();
+            for g in 0..groups {
+                for k in 0..per {
+                    b.push(g as i64 * step, 0, 0, (g + k) % 3 == 0);
+                }
+            }
+            b
+        };
+        let pick = |b: &EventBatch| {
+            let mut s = TemporalSampler::new(SamplingMethod::Auto, 1000);
+            s.push(b).unwrap();
+            let seq = s.finish().unwrap();
+            assert!(seq.reason.is_some());
+            seq.method
+        };
+        // a DVXplorer: hundreds of events per 200 µs scan
+        assert_eq!(pick(&stream(500, 300, 200)), SamplingMethod::Paper);
+        // a DVS128: one event every ~80 µs
+        assert_eq!(pick(&stream(5000, 1, 80)), SamplingMethod::Sum);
+        // a busy Prophesee sensor: ten events in every µs
+        assert_eq!(pick(&stream(20_000, 10, 1)), SamplingMethod::Sum);
+        // the paper's sampler on such a stream would vote with one timestamp's few events
+        let g = Grouping::measure(&stream(20_000, 10, 1).t);
+        assert!(!g.is_scanned() && (g.events_per_timestamp - 10.0).abs() < 1e-9);
     }
 }

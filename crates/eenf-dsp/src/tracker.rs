@@ -90,6 +90,15 @@ impl StftTracker {
     /// The peak frequency (Hz) in `band` of every window of `x`. A window whose band holds no
     /// energy gives NaN.
     pub fn track(&self, x: &[f64], band: (f64, f64)) -> Vec<f64> {
+        self.track_with_snr(x, band)
+            .into_iter()
+            .map(|(f, _)| f)
+            .collect()
+    }
+
+    /// [`StftTracker::track`], with each window's line strength: the peak's power over the
+    /// median power of the band, in dB (noise alone gives about 8 dB; NaN without energy).
+    pub fn track_with_snr(&self, x: &[f64], band: (f64, f64)) -> Vec<(f64, f64)> {
         let n = self.window_len();
         let half = n / 2;
         let step = self.step_len();
@@ -131,9 +140,20 @@ impl StftTracker {
                         .map(|k| (k, spec[k].norm_sqr()))
                         .fold((k_lo, -1.0), |b, c| if c.1 > b.1 { c } else { b });
                     if k_lo > k_hi || mag <= 0.0 {
-                        return f64::NAN;
+                        return (f64::NAN, f64::NAN);
                     }
-                    match peak {
+                    let snr_db = {
+                        let mut power: Vec<f64> =
+                            (k_lo..=k_hi).map(|k| spec[k].norm_sqr()).collect();
+                        let m = power.len() / 2;
+                        let median = *power.select_nth_unstable_by(m, f64::total_cmp).1;
+                        if median > 0.0 {
+                            10.0 * (mag / median).log10()
+                        } else {
+                            f64::INFINITY
+                        }
+                    };
+                    let f = match peak {
                         PeakMethod::Paper => {
                             let (a, b, c) = (spec[k - 1], spec[k], spec[k + 1]);
                             let delta = -((c - a) / (b * 2.0 - c - a)).re;
@@ -153,7 +173,8 @@ impl StftTracker {
                                 ((k - 1) as f64 * df, (k + 1) as f64 * df),
                             )
                         }
-                    }
+                    };
+                    (f, snr_db)
                 },
             )
             .collect()

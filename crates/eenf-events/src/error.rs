@@ -35,6 +35,14 @@ pub enum EventError {
         /// What is wrong.
         reason: String,
     },
+    /// What was asked of the file does not fit it (a chip or camera it cannot have).
+    #[error("{path}: {reason}")]
+    Unfit {
+        /// The file.
+        path: PathBuf,
+        /// What does not fit.
+        reason: String,
+    },
     /// The file ends before a structure it announces.
     #[error("{path}: truncated {format} file at byte {offset}: {reason}")]
     Truncated {

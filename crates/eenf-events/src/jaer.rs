@@ -16,24 +16,79 @@ enum Addressing {
     Dvs128,
 }
 
-/// The chip named in `# AEChip:`: addressing, width, height.
-fn chip(lines: &[String]) -> Option<(Addressing, u16, u16, String)> {
-    let line = lines.iter().find(|l| l.starts_with("AEChip:"))?;
-    let name = line["AEChip:".len()..].trim().to_string();
+/// A chip by name (`DVS128`, `DAVIS240`, … as jAER names them, any case): addressing,
+/// width, height.
+fn chip_named(name: &str) -> Option<(Addressing, u16, u16)> {
     let lower = name.to_ascii_lowercase();
-    let (a, w, h) = if lower.contains("davis346") {
+    Some(if lower.contains("davis346") {
         (Addressing::Davis, 346, 260)
     } else if lower.contains("davis240") {
         (Addressing::Davis, 240, 180)
     } else if lower.contains("davis640") {
         (Addressing::Davis, 640, 480)
-    } else if lower.contains("dvs128") {
+    } else if lower.contains("dvs128") || lower.contains("tmpdiff128") {
         (Addressing::Dvs128, 128, 128)
     } else {
         return None;
-    };
+    })
+}
+
+/// The chip named in `# AEChip:`: addressing, width, height, name.
+fn chip(lines: &[String]) -> Option<(Addressing, u16, u16, String)> {
+    let line = lines.iter().find(|l| l.starts_with("AEChip:"))?;
+    let name = line["AEChip:".len()..].trim().to_string();
+    let (a, w, h) = chip_named(&name)?;
     Some((a, w, h, name))
 }
+
+/// The chip that the first addresses of a file without `# AEChip:` fit. DVS128 addresses use
+/// 16 bits (x 7..1, y 14..8, bit 15 external or the eye); DAVIS addresses put y in bits 30..22
+/// and mark APS/IMU samples with bit 31. The DAVIS whose array holds the largest x and y wins.
+fn infer_chip(addresses: &[u32]) -> Option<(Addressing, u16, u16, String)> {
+    if addresses.is_empty() {
+        return None;
+    }
+    if addresses.iter().all(|&a| a < 1 << 16) {
+        return Some((Addressing::Dvs128, 128, 128, "DVS128".into()));
+    }
+    let dvs = addresses
+        .iter()
+        .filter(|&&a| a >> 31 == 0 && (a >> 10) & 1 == 0);
+    let (mx, my) = dvs.fold((0, 0), |(x, y), &a| {
+        (x.max((a >> 12) & 0x3FF), y.max((a >> 22) & 0x1FF))
+    });
+    for (name, w, h) in [
+        ("DAVIS240", 240, 180),
+        ("DAVIS346", 346, 260),
+        ("DAVIS640", 640, 480),
+    ] {
+        if mx < w && my < h {
+            return Some((Addressing::Davis, w as u16, h as u16, name.into()));
+        }
+    }
+    None
+}
+
+/// Addresses looked at to infer a chip and find a stereo pair.
+const PEEK_WORDS: usize = 65_536;
+
+/// The addresses of the first events after the header.
+fn peek_addresses(src: &mut dyn Source, path: &Path, start: u64) -> Result<Vec<u32>> {
+    src.seek(SeekFrom::Start(start))
+        .map_err(|e| io_err(path, e))?;
+    let mut bytes = Vec::new();
+    src.take((PEEK_WORDS * 8) as u64)
+        .read_to_end(&mut bytes)
+        .map_err(|e| io_err(path, e))?;
+    Ok(bytes
+        .chunks_exact(8)
+        .map(|w| u32::from_be_bytes([w[0], w[1], w[2], w[3]]))
+        .collect())
+}
+
+/// Share of DVS128 addresses with bit 15 set above which (and below one minus which) the file
+/// is a stereo pair: an external-event flag is rare, an eye is about half the events.
+const STEREO_SHARE: f64 = 0.05;
 
 /// AEDAT 2.0 decoder: big-endian (address, timestamp) pairs.
 pub(crate) struct Aedat2 {
@@ -41,6 +96,10 @@ pub(crate) struct Aedat2 {
     height: u16,
     unwrap: Unwrap,
     skips: Skips,
+    /// A DVS128 stereo pair: bit 15 is the eye, not an external event.
+    stereo: bool,
+    /// The eye kept, when one was picked.
+    camera: Option<u8>,
 }
 
 impl WordDecoder for Aedat2 {
@@ -66,7 +125,18 @@ impl WordDecoder for Aedat2 {
                         (addr >> 11) & 1 == 1,
                     )
                 }
-                Addressing::Dvs128 => ((addr >> 1) & 0x7F, (addr >> 8) & 0x7F, addr & 1 == 1),
+                Addressing::Dvs128 => {
+                    let bit15 = (addr >> 15) & 1;
+                    if !self.stereo && bit15 == 1 {
+                        self.skips.triggers += 1; // an external input event
+                        continue;
+                    }
+                    if self.stereo && self.camera.is_some_and(|c| u32::from(c) != bit15) {
+                        self.skips.other_camera += 1;
+                        continue;
+                    }
+                    ((addr >> 1) & 0x7F, (addr >> 8) & 0x7F, addr & 1 == 1)
+                }
             };
             if y_raw >= self.height as u32 {
                 return Err(format!("y {y_raw} outside the chip's {} rows", self.height));
@@ -85,30 +155,87 @@ impl WordDecoder for Aedat2 {
 
 /// Opens an AEDAT 2.0 file.
 pub fn open_aedat2(path: &Path) -> Result<Box<dyn EventReader>> {
-    aedat2_from(Box::new(std::fs::File::open(path).map_err(|e| io_err(path, e))?), path)
+    let src = Box::new(std::fs::File::open(path).map_err(|e| io_err(path, e))?);
+    aedat2_with(src, path, &crate::OpenOptions::default())
 }
 
-/// Reads AEDAT 2.0 from `src` (named `path` in errors).
-pub fn aedat2_from(mut src: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventReader>> {
+/// Reads AEDAT 2.0 from `src` (named `path` in errors): the chip from `opts`, else the header's
+/// `# AEChip:` line, else inferred from the first addresses (with a note); a DVS128 stereo
+/// pair is reported as two cameras, and `opts.camera` keeps one of them.
+pub fn aedat2_with(
+    mut src: Box<dyn Source>,
+    path: &Path,
+    opts: &crate::OpenOptions,
+) -> Result<Box<dyn EventReader>> {
     let header = read_text_header(src.as_mut(), path, b"#", None, "AEDAT 2.0")?;
-    let Some((addressing, w, h, _name)) = chip(&header.lines) else {
-        let named = header
-            .lines
-            .iter()
-            .find(|l| l.starts_with("AEChip:"))
-            .cloned()
-            .unwrap_or_else(|| "no AEChip line".into());
+    let addresses = peek_addresses(src.as_mut(), path, header.data_start)?;
+    let mut notes = Vec::new();
+    let named = header
+        .lines
+        .iter()
+        .find(|l| l.starts_with("AEChip:"))
+        .cloned()
+        .unwrap_or_else(|| "no AEChip line".into());
+    let found = match &opts.chip {
+        Some(name) => match chip_named(name) {
+            Some((a, w, h)) => {
+                notes.push(format!("chip {name} as asked (the header has {named})"));
+                Some((a, w, h, name.clone()))
+            }
+            None => {
+                return Err(EventError::Unfit {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "unknown chip {name:?}; known: DVS128, DAVIS240, DAVIS346, DAVIS640"
+                    ),
+                })
+            }
+        },
+        None => chip(&header.lines).or_else(|| {
+            let inferred = infer_chip(&addresses)?;
+            notes.push(format!(
+                "{named}: chip inferred from the addresses as {} (--chip overrides)",
+                inferred.3
+            ));
+            Some(inferred)
+        }),
+    };
+    let Some((addressing, w, h, _name)) = found else {
         return Err(EventError::Corrupt {
             path: path.to_path_buf(),
             format: "AEDAT 2.0",
             offset: 0,
-            reason: format!("unknown chip ({named}); known: DAVIS240, DAVIS346, DAVIS640, DVS128"),
+            reason: format!(
+                "unknown chip ({named}); known: DAVIS240, DAVIS346, DAVIS640, DVS128 (name it with --chip)"
+            ),
         });
     };
+    let eye = addresses.iter().filter(|&&a| (a >> 15) & 1 == 1).count() as f64
+        / addresses.len().max(1) as f64;
+    let stereo = addressing == Addressing::Dvs128
+        && addresses.len() >= 100
+        && (STEREO_SHARE..=1.0 - STEREO_SHARE).contains(&eye);
+    let cameras = if stereo {
+        vec![
+            "camera 0: address bit 15 clear".to_string(),
+            "camera 1: address bit 15 set".to_string(),
+        ]
+    } else {
+        Vec::new()
+    };
+    if stereo {
+        notes.push(format!(
+            "a stereo pair: {:.0} % of the events from camera 1 (address bit 15), each camera on its own clock",
+            100.0 * eye
+        ));
+    }
     let info = StreamInfo {
         format: "AEDAT 2.0",
         width: Some(w),
         height: Some(h),
+        cameras,
+        camera: if stereo { opts.camera } else { None },
+        notes,
         ..StreamInfo::default()
     };
     Ok(Box::new(WordStream::new(
@@ -120,6 +247,8 @@ pub fn aedat2_from(mut src: Box<dyn Source>, path: &Path) -> Result<Box<dyn Even
             height: h,
             unwrap: Unwrap::default(),
             skips: Skips::default(),
+            stereo,
+            camera: opts.camera,
         },
         info,
     )?))
@@ -143,7 +272,10 @@ pub struct Aedat31Reader {
 
 /// Opens an AEDAT 3.1 file.
 pub fn open_aedat31(path: &Path) -> Result<Box<dyn EventReader>> {
-    aedat31_from(Box::new(std::fs::File::open(path).map_err(|e| io_err(path, e))?), path)
+    aedat31_from(
+        Box::new(std::fs::File::open(path).map_err(|e| io_err(path, e))?),
+        path,
+    )
 }
 
 /// Reads AEDAT 3.1 from `src` (named `path` in errors).

@@ -73,6 +73,22 @@ pub struct StreamInfo {
     pub last_t: Option<i64>,
     /// True when the file carries an index (FileDataTable).
     pub indexed: bool,
+    /// The cameras of a file that holds several (a jAER stereo pair), by number; empty for one.
+    pub cameras: Vec<String>,
+    /// The camera read, when there are several and one was picked.
+    pub camera: Option<u8>,
+    /// What the reader had to infer or assume (e.g. a chip not named in the header).
+    pub notes: Vec<String>,
+}
+
+/// How to read files that leave something open.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct OpenOptions {
+    /// The chip of a jAER AEDAT 2.0 file (`DVS128`, `DAVIS240`, `DAVIS346`, `DAVIS640`),
+    /// overriding its `# AEChip:` line or the chip inferred from its addresses.
+    pub chip: Option<String>,
+    /// In a file with several cameras (a jAER stereo pair), read only this one (0, 1, …).
+    pub camera: Option<u8>,
 }
 
 /// A source of event batches.
@@ -217,15 +233,38 @@ pub fn probe_source(src: &mut dyn Source, path: &Path) -> Result<Probed> {
 
 /// Opens an event file with the reader its content calls for.
 pub fn open(path: &Path) -> Result<Box<dyn EventReader>> {
+    open_with(path, &OpenOptions::default())
+}
+
+/// Opens an event file as `opts` say.
+pub fn open_with(path: &Path, opts: &OpenOptions) -> Result<Box<dyn EventReader>> {
     let f = std::fs::File::open(path).map_err(|e| error::io_err(path, e))?;
-    open_source(Box::new(f), path)
+    open_source_with(Box::new(f), path, opts)
 }
 
 /// The reader that the content of `src` (named `path` in errors) calls for. The head is read
 /// once, and the same stream is handed to the reader.
-pub fn open_source(mut src: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventReader>> {
+pub fn open_source(src: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventReader>> {
+    open_source_with(src, path, &OpenOptions::default())
+}
+
+/// [`open_source`] as `opts` say.
+pub fn open_source_with(
+    mut src: Box<dyn Source>,
+    path: &Path,
+    opts: &OpenOptions,
+) -> Result<Box<dyn EventReader>> {
     let probed = probe_source(src.as_mut(), path)?;
-    Ok(match probed.format {
+    let option_error = |reason: String| EventError::Unfit {
+        path: path.to_path_buf(),
+        reason,
+    };
+    if opts.chip.is_some() && probed.format != Format::Aedat2 {
+        return Err(option_error(
+            "a chip can be named only for jAER AEDAT 2.0 files".into(),
+        ));
+    }
+    let reader: Box<dyn EventReader> = match probed.format {
         Format::Aedat4 => Box::new(Aedat4Reader::new(src, path)?),
         Format::Prophesee(kind) => {
             let header = match probed.header {
@@ -234,10 +273,20 @@ pub fn open_source(mut src: Box<dyn Source>, path: &Path) -> Result<Box<dyn Even
             };
             prophesee::from_header(src, path, header, kind)?
         }
-        Format::Aedat2 => jaer::aedat2_from(src, path)?,
+        Format::Aedat2 => jaer::aedat2_with(src, path, opts)?,
         Format::Aedat31 => jaer::aedat31_from(src, path)?,
         Format::Text => Box::new(TextReader::new(src, path)?),
-    })
+    };
+    if let Some(c) = opts.camera {
+        let n = reader.info().cameras.len().max(1);
+        if c as usize >= n {
+            return Err(option_error(format!(
+                "camera {c} asked for, but the file holds {n} camera{} (numbered from 0)",
+                if n == 1 { "" } else { "s" }
+            )));
+        }
+    }
+    Ok(reader)
 }
 
 /// Counts and ranges of a whole stream, from reading it to the end.

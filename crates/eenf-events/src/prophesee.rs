@@ -96,7 +96,8 @@ pub(crate) fn from_header(
     let info = |name| header_info(&header.lines, name);
     Ok(match kind {
         ProphFormat::Evt2 => Box::new(
-            WordStream::new(src, path, start, Evt2::default(), info("EVT 2.0"))?.with_offset(offset),
+            WordStream::new(src, path, start, Evt2::default(), info("EVT 2.0"))?
+                .with_offset(offset),
         ),
         ProphFormat::Evt21 { legacy } => {
             let dec = Evt21 {
@@ -106,7 +107,8 @@ pub(crate) fn from_header(
             Box::new(WordStream::new(src, path, start, dec, info("EVT 2.1"))?.with_offset(offset))
         }
         ProphFormat::Evt3 => Box::new(
-            WordStream::new(src, path, start, Evt3::default(), info("EVT 3.0"))?.with_offset(offset),
+            WordStream::new(src, path, start, Evt3::default(), info("EVT 3.0"))?
+                .with_offset(offset),
         ),
         ProphFormat::Dat => open_dat(src, path, start, &header.lines)?,
     })
@@ -421,5 +423,4 @@ impl Skips {
             _ => self.unknown += 1,
         }
     }
-
 }

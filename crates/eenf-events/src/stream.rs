@@ -251,6 +251,7 @@ pub(crate) struct Skips {
     pub other: u64,
     pub before_time: u64,
     pub unknown: u64,
+    pub other_camera: u64,
 }
 
 impl Skips {
@@ -260,6 +261,7 @@ impl Skips {
             ("other (IMU/APS/system)", self.other),
             ("before the first time word", self.before_time),
             ("unknown type", self.unknown),
+            ("the other camera's", self.other_camera),
         ]
         .into_iter()
         .filter(|(_, n)| *n > 0)

@@ -112,7 +112,10 @@ pub struct TextReader {
 impl TextReader {
     /// Opens a text event file; the time unit is decided from the first event line.
     pub fn open(path: &Path) -> Result<Self> {
-        Self::new(Box::new(File::open(path).map_err(|e| io_err(path, e))?), path)
+        Self::new(
+            Box::new(File::open(path).map_err(|e| io_err(path, e))?),
+            path,
+        )
     }
 
     /// Reads text events from `f` (named `path` in errors).

@@ -44,7 +44,11 @@ impl std::str::FromStr for OutputFormat {
             "evt3" | "evt3.0" => OutputFormat::Evt3,
             "dat" => OutputFormat::Dat,
             "text" | "txt" => OutputFormat::Text,
-            _ => return Err(format!("{name:?}: expected aedat4, evt2, evt3, dat or text")),
+            _ => {
+                return Err(format!(
+                    "{name:?}: expected aedat4, evt2, evt3, dat or text"
+                ))
+            }
         })
     }
 }

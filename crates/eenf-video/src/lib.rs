@@ -23,7 +23,7 @@ mod venf;
 pub use source::{FfmpegSource, FrameSource, VideoInfo, Y4mSource, Y4mWriter, MAX_FRAME_BYTES};
 pub use venf::{
     estimate_virtual_rows, strongest_line, video_enf, video_enf_from_rows, IdleRows, RowMeans,
-    RowSampling, SceneRemoval, VideoOptions, VideoAnalysis,
+    RowSampling, SceneRemoval, VideoAnalysis, VideoOptions,
 };
 
 /// Why a video could not be read or traced.

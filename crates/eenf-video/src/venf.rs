@@ -292,7 +292,10 @@ fn sample(rows: &RowMeans, sampling: RowSampling, virtual_rows: Option<f64>) -> 
 }
 
 /// V-ENF on row means already read (see [`RowMeans::read`]).
-pub fn video_enf_from_rows(raw: &RowMeans, opts: &VideoOptions) -> Result<VideoAnalysis, VideoError> {
+pub fn video_enf_from_rows(
+    raw: &RowMeans,
+    opts: &VideoOptions,
+) -> Result<VideoAnalysis, VideoError> {
     let info = raw.info;
     let p = &opts.params;
     let duration = raw.frames() as f64 / info.fps;

@@ -38,7 +38,9 @@ pub fn recording_start(path: &Path) -> Option<LocalTime> {
     if d.len() < 6 || d[1..].iter().any(|&v| !(0..=99).contains(&v)) {
         return None;
     }
-    LocalTime::new(d[0], d[1] as i8, d[2] as i8, d[3] as i8, d[4] as i8, d[5] as i8)
+    LocalTime::new(
+        d[0], d[1] as i8, d[2] as i8, d[3] as i8, d[4] as i8, d[5] as i8,
+    )
 }
 
 /// The start time of an hourly reference named `YYYY_MM_DD_Day_HH_00_00.wav`.
@@ -187,7 +189,10 @@ fn preset(name: &str) -> Result<(Classes, f64, (u16, u16))> {
 /// over the coverage (distinct whole seconds, 30 s from its ends; one may run across an hour,
 /// the references continue in the next file), lamps, light and sensor biases drawn from
 /// the seed.
-pub fn plan_dataset(spec: &DatasetSpec, (from, to): (f64, f64)) -> Result<(Vec<PlannedRecording>, f64)> {
+pub fn plan_dataset(
+    spec: &DatasetSpec,
+    (from, to): (f64, f64),
+) -> Result<(Vec<PlannedRecording>, f64)> {
     let (classes, preset_duration, preset_res) = preset(&spec.preset)?;
     let duration = spec.duration_s.unwrap_or(preset_duration);
     if !(20.0..=3600.0).contains(&duration) {

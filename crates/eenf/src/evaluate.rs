@@ -164,7 +164,6 @@ pub fn compare_trace(
     )
 }
 
-
 /// Pairs of (time, estimate, reference) where the reference holds a value at estimate time +
 /// `offset_s` (times matched to the millisecond).
 pub fn align(
@@ -192,7 +191,6 @@ pub fn align(
     }
     out
 }
-
 
 #[cfg(test)]
 mod tests {

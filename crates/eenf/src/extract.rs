@@ -4,10 +4,10 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use eenf_dsp::{
-    check_line, detect_nominal, extract_enf, EnfParams, PolaritySequence, SamplingMethod,
-    TemporalSampler,
+    check_line, detect_nominal, extract_enf, flicker_line, flicker_lines, EnfParams, FlickerLine,
+    PolaritySequence, SamplingMethod, TemporalSampler, MIN_FLICKER_PROMINENCE,
 };
-use eenf_events::StreamInfo;
+use eenf_events::{OpenOptions, StreamInfo};
 
 use crate::progress::Progress;
 use crate::trace::{EventsProvenance, Trace};
@@ -36,7 +36,7 @@ impl std::str::FromStr for Nominal {
 /// How events become a trace.
 #[derive(Debug, Clone)]
 pub struct ExtractOptions {
-    /// Temporal sampling variant.
+    /// Temporal sampling (`Auto` chooses from the stream).
     pub sampling: SamplingMethod,
     /// Sampling interval, µs.
     pub dt_us: i64,
@@ -44,27 +44,50 @@ pub struct ExtractOptions {
     pub nominal: Nominal,
     /// Everything after sampling (`nominal_hz` is set from `nominal`).
     pub params: EnfParams,
+    /// How to read the file: the chip of an old jAER file, the camera of a stereo pair (by
+    /// default the one whose flicker is stronger).
+    pub open: OpenOptions,
 }
 
 impl Default for ExtractOptions {
     fn default() -> Self {
         ExtractOptions {
-            sampling: SamplingMethod::Paper,
+            sampling: SamplingMethod::Auto,
             dt_us: 1000,
             nominal: Nominal::Auto,
             params: EnfParams::default(),
+            open: OpenOptions::default(),
         }
     }
 }
 
-/// Reads an event file into a polarity sequence.
-pub fn sample_file(
+/// The shortest recording traced, s: below it a window holds too few flicker periods to place
+/// the line.
+pub const MIN_WINDOW_S: f64 = 2.0;
+
+/// A file read into its flicker signal.
+pub struct Sampled {
+    /// What its header said.
+    pub info: StreamInfo,
+    /// Events read.
+    pub events: u64,
+    /// The flicker signal.
+    pub seq: PolaritySequence,
+    /// The camera read, when the file holds several.
+    pub camera: Option<u8>,
+    /// What had to be decided on the way (camera, chip), for the user.
+    pub notes: Vec<String>,
+}
+
+/// Reads `path` (as `open` says) into a flicker signal sampled with `sampling` every `dt_us`.
+pub fn sample_with(
     path: &Path,
+    open: &OpenOptions,
     sampling: SamplingMethod,
     dt_us: i64,
     progress: &Progress,
-) -> Result<(StreamInfo, u64, PolaritySequence)> {
-    let mut reader = eenf_events::open(path)?;
+) -> Result<Sampled> {
+    let mut reader = eenf_events::open_with(path, open)?;
     let info = reader.info().clone();
     let bar = progress.events(info.event_count, "reading events");
     let mut sampler = TemporalSampler::new(sampling, dt_us);
@@ -82,60 +105,161 @@ pub fn sample_file(
     let seq = sampler
         .finish()
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    Ok((info, events, seq))
+    Ok(Sampled {
+        notes: info.notes.clone(),
+        camera: info.camera,
+        info,
+        events,
+        seq,
+    })
+}
+
+/// Reads an event file into its flicker signal. A file with several cameras (a stereo pair,
+/// whose cameras run on two clocks) is read for the camera `opts.open` names, else for the one
+/// whose flicker line stands higher: never a mix of both.
+pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> Result<Sampled> {
+    let cameras = eenf_events::open_with(path, &opts.open)?
+        .info()
+        .cameras
+        .len();
+    if cameras < 2 || opts.open.camera.is_some() {
+        return sample_with(path, &opts.open, opts.sampling, opts.dt_us, progress);
+    }
+    let mut best: Option<(u8, f64)> = None;
+    let mut heard = Vec::new();
+    for c in 0..cameras.min(u8::MAX as usize) as u8 {
+        let open = OpenOptions {
+            camera: Some(c),
+            ..opts.open.clone()
+        };
+        let s = sample_with(path, &open, SamplingMethod::Sum, 1000, &Progress::hidden())?;
+        let x: Vec<f64> = s.seq.values.iter().map(|&v| v as f64).collect();
+        let line = flicker_line(&x, s.seq.fs());
+        let prominence = line.map_or(0.0, |l| l.prominence);
+        heard.push(match line {
+            Some(l) => format!("camera {c}: {:.3} Hz, {:.1}x", l.hz, l.prominence),
+            None => format!("camera {c}: no line"),
+        });
+        if best.is_none_or(|b| prominence > b.1) {
+            best = Some((c, prominence));
+        }
+    }
+    let (camera, _) = best.unwrap_or((0, 0.0));
+    let open = OpenOptions {
+        camera: Some(camera),
+        ..opts.open.clone()
+    };
+    let mut s = sample_with(path, &open, opts.sampling, opts.dt_us, progress)?;
+    s.notes.push(format!(
+        "{cameras} cameras: camera {camera} traced, its flicker stands highest ({}); --camera picks another",
+        heard.join("; ")
+    ));
+    Ok(s)
 }
 
 /// E-ENF from an event file.
 pub fn extract_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> Result<Trace> {
-    let (info, events, seq) = sample_file(path, opts.sampling, opts.dt_us, progress)?;
-    extract_sequence(path, info, events, &seq, opts, progress)
+    let s = sample_file(path, opts, progress)?;
+    extract_sampled(path, s, opts, progress)
 }
 
-/// E-ENF from a polarity sequence already sampled from `path` (with `opts.sampling` and
-/// `opts.dt_us`).
-pub fn extract_sequence(
-    path: &Path,
-    info: StreamInfo,
-    events: u64,
-    seq: &PolaritySequence,
-    opts: &ExtractOptions,
-    progress: &Progress,
-) -> Result<Trace> {
-    let x: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
-    let fs = seq.fs();
-    let mut params = opts.params.clone();
-    let err = |e: eenf_dsp::DspError| anyhow::anyhow!("{}: {e}", path.display());
-    if seq.duration_s() < params.window_s {
-        return Err(err(eenf_dsp::DspError::TooShort {
-            duration_s: seq.duration_s(),
-            window_s: params.window_s,
-        }));
-    }
-    params.nominal_hz = match opts.nominal {
-        Nominal::Auto => detect_nominal(&x, fs, 2.0).map_err(err)?,
-        Nominal::Hz(f) => {
+/// The grid of a flicker signal: decided from its strongest line near 100/120 Hz, or checked
+/// against `nominal`. Also returns the line, and a note when the line sits off twice the grid
+/// by more than a grid wanders (a camera clock that runs off).
+fn decide_grid(
+    x: &[f64],
+    fs: f64,
+    nominal: Nominal,
+    harmonics: usize,
+) -> std::result::Result<(f64, Option<FlickerLine>, Option<String>), eenf_dsp::DspError> {
+    let lines = flicker_lines(x, fs);
+    let line = match (nominal, lines) {
+        (_, None) => None,
+        (Nominal::Auto, Some([a, b])) => Some(if a.prominence >= b.prominence { a } else { b }),
+        (Nominal::Hz(f), Some([a, b])) => Some(if f == 50.0 { a } else { b }),
+    };
+    let f0 = match (nominal, line) {
+        (Nominal::Auto, Some(l)) if l.is_mains() => l.grid_hz,
+        (Nominal::Auto, Some(l)) => {
+            return Err(eenf_dsp::DspError::NoTone(format!(
+                "no mains flicker: the strongest line near 100 or 120 Hz, at {:.3} Hz, stands {:.1}x above the noise ({MIN_FLICKER_PROMINENCE}x needed)",
+                l.hz, l.prominence
+            )))
+        }
+        // too short or sampled too slowly for the whole-recording line: the older local test
+        (Nominal::Auto, None) => detect_nominal(x, fs, 2.0)?,
+        (Nominal::Hz(f), l) => {
             // the flicker line may be weak at 2f0 yet strong at a higher harmonic
-            let ok = (1..=params.harmonics.max(1))
-                .any(|m| check_line(&x, fs, f, 2.0 * m as f64).is_ok());
+            let ok = l.is_some_and(|l| l.is_mains())
+                || (1..=harmonics.max(1)).any(|m| check_line(x, fs, f, 2.0 * m as f64).is_ok());
             if !ok {
-                check_line(&x, fs, f, 2.0).map_err(err)?;
+                check_line(x, fs, f, 2.0)?;
             }
             f
         }
     };
+    let note = line.filter(|l| l.is_mains() && l.offset.abs() > 1e-3).map(|l| {
+        format!(
+            "the flicker line is at {:.3} Hz, {:.2} % {} {} Hz: the camera's clock (or the grid) is off by that much; the trace is reported as measured",
+            l.hz,
+            100.0 * l.offset.abs(),
+            if l.offset < 0.0 { "below" } else { "above" },
+            2.0 * l.grid_hz
+        )
+    });
+    Ok((f0, line, note))
+}
+
+/// E-ENF from a flicker signal already read from `path`.
+pub fn extract_sampled(
+    path: &Path,
+    s: Sampled,
+    opts: &ExtractOptions,
+    progress: &Progress,
+) -> Result<Trace> {
+    let seq = &s.seq;
+    let x: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
+    let fs = seq.fs();
+    let mut params = opts.params.clone();
+    let mut notes = s.notes;
+    let err = |e: eenf_dsp::DspError| anyhow::anyhow!("{}: {e}", path.display());
+    let duration = seq.duration_s();
+    if duration < params.window_s {
+        if duration < MIN_WINDOW_S {
+            return Err(err(eenf_dsp::DspError::TooShort {
+                duration_s: duration,
+                window_s: MIN_WINDOW_S,
+            }));
+        }
+        // a window that fits: as long as the recording allows, to a tenth of a second
+        let window = ((duration * 10.0).floor() / 10.0).max(MIN_WINDOW_S);
+        notes.push(format!(
+            "the recording lasts {duration:.2} s, shorter than the {} s window: traced with a {window} s window (frequency resolution {:.3} Hz on the flicker, {:.3} Hz on the ENF)",
+            params.window_s,
+            1.0 / window,
+            0.5 / window
+        ));
+        params.window_s = window;
+    }
+    let (f0, line, note) = decide_grid(&x, fs, opts.nominal, params.harmonics).map_err(err)?;
+    params.nominal_hz = f0;
+    notes.extend(note);
     let spin = progress.spinner("tracking the ENF");
     let estimates = extract_enf(seq, &params).map_err(err)?;
     spin.finish_and_clear();
     let provenance = EventsProvenance {
-        format: info.format.to_string(),
+        format: s.info.format.to_string(),
         start_t_us: seq.t0_us,
         start_utc: crate::time::utc_micros(seq.t0_us),
-        events,
-        duration_s: seq.duration_s(),
-        sampling: opts.sampling,
+        events: s.events,
+        duration_s: duration,
+        sampling: seq.method,
+        sampling_reason: seq.reason.clone(),
         dt_us: opts.dt_us,
         params,
+        camera: s.camera,
+        flicker: line,
+        notes,
     };
     Ok(Trace::from_events(path, &estimates, provenance))
 }
-

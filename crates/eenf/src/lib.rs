@@ -17,6 +17,7 @@ pub mod bench;
 pub mod dataset;
 pub mod evaluate;
 pub mod extract;
+pub mod inspect;
 pub mod output;
 pub mod plot;
 pub mod progress;

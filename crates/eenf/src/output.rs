@@ -84,7 +84,12 @@ impl AtomicFile {
     /// Puts the finished file in place.
     pub fn commit(self) -> Result<()> {
         let target = self.target;
-        let what = || format!("{}: cannot move the finished file into place", target.display());
+        let what = || {
+            format!(
+                "{}: cannot move the finished file into place",
+                target.display()
+            )
+        };
         self.tmp.as_file().sync_all().with_context(what)?;
         if self.special {
             let mut src = self.tmp.reopen().with_context(what)?;
@@ -95,7 +100,10 @@ impl AtomicFile {
             std::io::copy(&mut src, &mut dst).with_context(what)?;
             return Ok(());
         }
-        self.tmp.persist(&target).map_err(|e| e.error).with_context(what)?;
+        self.tmp
+            .persist(&target)
+            .map_err(|e| e.error)
+            .with_context(what)?;
         Ok(())
     }
 }

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use anyhow::{anyhow, bail, Result};
 use crate::trace::Trace;
+use anyhow::{anyhow, bail, Result};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -131,7 +131,6 @@ pub fn reference_for_recording(
     Ok(Trace::from_mains(dir, f0, &p, out))
 }
 
-
 /// Unix time of an hourly reference's name read as local time at `tz_s` seconds east of UTC.
 pub fn wav_start(path: &Path, tz_s: f64) -> Result<f64> {
     let t = crate::dataset::reference_hour(path).with_context(|| {
@@ -285,7 +284,12 @@ impl ReferenceSeries {
             }
         } else {
             let t = Trace::read(path, None)?;
-            (t.time_s.first().copied().unwrap_or(0.0), false, t.step_s, t.enf_hz)
+            (
+                t.time_s.first().copied().unwrap_or(0.0),
+                false,
+                t.step_s,
+                t.enf_hz,
+            )
         };
         Ok(vec![ReferenceSeries {
             name: path.display().to_string(),

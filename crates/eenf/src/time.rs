@@ -20,10 +20,9 @@ impl LocalTime {
 
     /// The wall-clock time `seconds` after 1970-01-01 00:00 (local time, no zone).
     pub fn from_local_seconds(seconds: i64) -> Self {
-        let ts = Timestamp::from_second(seconds.clamp(
-            Timestamp::MIN.as_second(),
-            Timestamp::MAX.as_second(),
-        ))
+        let ts = Timestamp::from_second(
+            seconds.clamp(Timestamp::MIN.as_second(), Timestamp::MAX.as_second()),
+        )
         .unwrap_or(Timestamp::UNIX_EPOCH);
         LocalTime(Offset::UTC.to_datetime(ts))
     }

@@ -6,7 +6,7 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use eenf_dsp::{EnfEstimates, EnfParams, PeakMethod, SamplingMethod};
+use eenf_dsp::{EnfEstimates, EnfParams, FlickerLine, PeakMethod, SamplingMethod};
 use eenf_video::{RowSampling, SceneRemoval, VideoAnalysis, VideoOptions};
 use serde::{Deserialize, Serialize};
 
@@ -23,6 +23,9 @@ pub struct HarmonicPart {
     /// ENF estimates on this band, Hz (NaN = none; `null` in JSON).
     #[serde(with = "nan_as_null")]
     pub enf_hz: Vec<f64>,
+    /// The line's strength over the band's noise in each window, dB.
+    #[serde(default, with = "nan_as_null", skip_serializing_if = "Vec::is_empty")]
+    pub snr_db: Vec<f64>,
 }
 
 /// The harmonic chosen for one selection segment (E-ENF).
@@ -47,12 +50,24 @@ pub struct EventsProvenance {
     pub events: u64,
     /// Seconds covered by the polarity sequence.
     pub duration_s: f64,
-    /// Temporal sampling used.
+    /// Temporal sampling used (`auto` resolved).
     pub sampling: SamplingMethod,
+    /// Why `auto` chose it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampling_reason: Option<String>,
     /// Sampling interval, µs.
     pub dt_us: i64,
     /// Every parameter of the tracker (with the grid decided).
     pub params: EnfParams,
+    /// The camera traced, in a file with several.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub camera: Option<u8>,
+    /// The recording's flicker line (whole recording, Hann window), when measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flicker: Option<FlickerLine>,
+    /// What was inferred or adapted on the way (chip, camera, window, clock).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 /// Marks a V-ENF trace in JSON (`"method": "v-enf"`).
@@ -126,6 +141,8 @@ pub struct Trace {
     pub time_s: Vec<f64>,
     /// ENF, Hz (NaN = no estimate).
     pub enf_hz: Vec<f64>,
+    /// Each estimate's line strength over its noise, dB (empty when not measured).
+    pub snr_db: Vec<f64>,
     /// Per-harmonic estimates (E-ENF).
     pub harmonics: Vec<HarmonicPart>,
     /// The harmonic chosen per selection segment (E-ENF).
@@ -146,6 +163,8 @@ struct TraceJson {
     time_s: Vec<f64>,
     #[serde(with = "nan_as_null")]
     enf_hz: Vec<f64>,
+    #[serde(default, with = "nan_as_null", skip_serializing_if = "Vec::is_empty")]
+    snr_db: Vec<f64>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     harmonics: Vec<HarmonicPart>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -169,7 +188,11 @@ impl Trace {
     }
 
     /// The E-ENF trace of `estimates`, made from an event recording as `provenance` says.
-    pub fn from_events(file: &Path, estimates: &EnfEstimates, provenance: EventsProvenance) -> Self {
+    pub fn from_events(
+        file: &Path,
+        estimates: &EnfEstimates,
+        provenance: EventsProvenance,
+    ) -> Self {
         let seg = estimates.segment_len as f64 * estimates.step_s;
         Trace {
             file: Some(file.to_path_buf()),
@@ -181,6 +204,7 @@ impl Trace {
                     harmonic: h.harmonic,
                     center_hz: h.center_hz,
                     enf_hz: h.enf_hz.clone(),
+                    snr_db: h.snr_db.clone(),
                 })
                 .collect(),
             selected: estimates
@@ -193,6 +217,7 @@ impl Trace {
                 })
                 .collect(),
             provenance: Some(Provenance::Events(provenance)),
+            snr_db: estimates.snr_db.clone(),
             ..Trace::new(estimates.step_s, estimates.enf_hz.clone())
         }
     }
@@ -267,7 +292,9 @@ impl Trace {
 
     /// Mean of the finite estimates (NaN when there are none).
     pub fn mean_hz(&self) -> f64 {
-        let (sum, n) = self.finite().fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+        let (sum, n) = self
+            .finite()
+            .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
         if n == 0 {
             f64::NAN
         } else {
@@ -281,17 +308,31 @@ impl Trace {
         [50.0, 60.0].into_iter().find(|f| (mean - f).abs() < 1.0)
     }
 
-    /// Writes `time_s,enf_hz` rows (an empty field for no estimate).
+    /// Writes `time_s,enf_hz` rows (an empty field for no estimate), and `snr_db` as a third
+    /// column when the trace measured it.
     pub fn write_csv(&self, w: &mut dyn Write) -> Result<()> {
         let mut out = csv::WriterBuilder::new().from_writer(w);
-        out.write_record(CSV_HEADER.split(','))?;
-        for (t, f) in self.time_s.iter().zip(&self.enf_hz) {
-            let f = if f.is_finite() {
-                f.to_string()
-            } else {
-                String::new()
-            };
-            out.write_record([t.to_string(), f])?;
+        let num = |v: Option<&f64>| match v {
+            Some(v) if v.is_finite() => v.to_string(),
+            _ => String::new(),
+        };
+        let with_snr = !self.snr_db.is_empty();
+        let mut header: Vec<&str> = CSV_HEADER.split(',').collect();
+        if with_snr {
+            header.push("snr_db");
+        }
+        out.write_record(&header)?;
+        for (i, t) in self.time_s.iter().enumerate() {
+            let mut row = vec![t.to_string(), num(self.enf_hz.get(i))];
+            if with_snr {
+                let s = self.snr_db.get(i).copied().unwrap_or(f64::NAN);
+                row.push(if s.is_finite() {
+                    format!("{s:.2}")
+                } else {
+                    String::new()
+                });
+            }
+            out.write_record(&row)?;
         }
         out.flush()?;
         Ok(())
@@ -305,6 +346,7 @@ impl Trace {
             step_s: Some(self.step_s),
             time_s: self.time_s.clone(),
             enf_hz: self.enf_hz.clone(),
+            snr_db: self.snr_db.clone(),
             harmonics: self.harmonics.clone(),
             selected: self.selected.clone(),
         };
@@ -375,6 +417,7 @@ impl Trace {
             nominal_hz: core.nominal_hz,
             time_s: core.time_s,
             enf_hz: core.enf_hz,
+            snr_db: core.snr_db,
             harmonics: core.harmonics,
             selected: core.selected,
             provenance: serde_json::from_value(v).ok(),
@@ -399,6 +442,7 @@ impl Trace {
                 path.display()
             );
         };
+        let si = col("snr_db");
         let mut trace = Trace {
             file: Some(path.to_path_buf()),
             ..Trace::default()
@@ -422,6 +466,9 @@ impl Trace {
             };
             trace.time_s.push(t);
             trace.enf_hz.push(v);
+            if let Some(si) = si {
+                trace.snr_db.push(field(si).parse().unwrap_or(f64::NAN));
+            }
         }
         if trace.time_s.is_empty() {
             bail!("{}: the trace is empty", path.display());

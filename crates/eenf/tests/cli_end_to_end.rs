@@ -71,7 +71,9 @@ fn simulate_extract_compare_meets_the_papers_accuracy() {
     assert!(d.join("s.svg").metadata().unwrap().len() > 1000);
     let csv = std::fs::read_to_string(d.join("s.enf.csv")).unwrap();
     let first: Vec<&str> = csv.lines().nth(1).unwrap().split(',').collect();
-    assert_eq!(csv.lines().next(), Some("time_s,enf_hz"));
+    // the first two columns stay `time_s,enf_hz`; E-ENF adds each estimate's line strength
+    assert_eq!(csv.lines().next(), Some("time_s,enf_hz,snr_db"));
+    assert!(first[2].parse::<f64>().unwrap() > 12.0, "{first:?}");
     assert_eq!(first[0], "0");
     assert!(
         (first[1].parse::<f64>().unwrap() - 50.0).abs() < 0.2,

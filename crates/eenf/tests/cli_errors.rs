@@ -103,8 +103,8 @@ fn bad_inputs_give_one_line_errors() {
         .unwrap();
     fails(&["extract", "empty.aedat4"], d, "empty.aedat4", "empty");
 
-    // shorter than one 16 s window
-    simulate(d, "short.aedat4", "5");
+    // shorter than the shortest window (2 s; longer recordings get a window that fits)
+    simulate(d, "short.aedat4", "1.5");
     fails(
         &["extract", "short.aedat4"],
         d,
@@ -163,7 +163,7 @@ fn bad_inputs_give_one_line_errors() {
 fn outputs_are_all_or_nothing() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
-    simulate(d, "short.aedat4", "5");
+    simulate(d, "short.aedat4", "1.5");
     let (ok, _, _) = eenf(&["extract", "short.aedat4", "-o", "trace.csv"], d);
     assert!(!ok);
     // no partial or temporary file left behind
@@ -219,4 +219,22 @@ fn writing_to_a_fifo_writes_into_it_instead_of_replacing_it() {
             "{args:?} replaced the FIFO"
         );
     }
+}
+
+#[test]
+fn a_recording_shorter_than_the_window_is_traced_with_one_that_fits() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    simulate(d, "three.aedat4", "3");
+    let (ok, out, err) = eenf(&["extract", "three.aedat4"], d);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("shorter than the 16 s window: traced with a 3 s window"),
+        "{err}"
+    );
+    assert!(err.contains("frequency resolution 0.333 Hz"), "{err}");
+    let rows: Vec<&str> = out.lines().skip(1).collect();
+    assert!(!rows.is_empty());
+    let f: f64 = rows[0].split(',').nth(1).unwrap().parse().unwrap();
+    assert!((f - 50.0).abs() < 0.1, "{f}");
 }

@@ -278,7 +278,10 @@ struct Slot {
 impl Aedat4Reader {
     /// Opens the file and reads its header (and FileDataTable, when present).
     pub fn open(path: &Path) -> Result<Self> {
-        Self::new(Box::new(File::open(path).map_err(|e| io_err(path, e))?), path)
+        Self::new(
+            Box::new(File::open(path).map_err(|e| io_err(path, e))?),
+            path,
+        )
     }
 
     /// Reads AEDAT 4.0 from `src` (named `path` in errors): its header, and its FileDataTable
@@ -337,10 +340,8 @@ impl Aedat4Reader {
             width: evs.and_then(|s| s.width),
             height: evs.and_then(|s| s.height),
             streams: streams.clone(),
-            event_count: None,
-            first_t: None,
-            last_t: None,
             indexed: false,
+            ..StreamInfo::default()
         };
         if has_table {
             // A damaged table only costs the up-front summary; the packets are still readable.

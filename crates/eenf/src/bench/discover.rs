@@ -228,4 +228,3 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Recording>> {
     }
     Ok(out)
 }
-

@@ -133,4 +133,3 @@ impl std::str::FromStr for Method {
             .ok_or_else(|| format!("unknown method {s:?} (e-enf, v-enf-lr, v-enf-hr)"))
     }
 }
-

@@ -8,7 +8,9 @@ use eenf_dsp::Agreement;
 
 use super::{paper_value, Method, Outcome, Recording, Run};
 use crate::output::write_atomic;
-use crate::plot::{plot_extraction, plot_methods, plot_spectrogram, plot_summary, Series, SummaryBar};
+use crate::plot::{
+    plot_extraction, plot_methods, plot_spectrogram, plot_summary, Series, SummaryBar,
+};
 use crate::progress::Progress;
 
 fn fmt_cc(v: f64) -> String {

@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::{class_rank, Method, Recording, Settings};
 use crate::evaluate::{compare, Comparison, Reference};
-use crate::extract::{extract_sequence, sample_file, Nominal};
+use crate::extract::{extract_sampled, sample_file, Nominal};
 use crate::progress::Progress;
 use crate::trace::Trace;
 
@@ -68,22 +68,32 @@ pub fn evaluate(
 }
 
 /// E-ENF on the recording's events.
-fn trace_events(rec: &Recording, s: &Settings, spectrum: bool) -> Result<(Trace, Option<Spectrogram>)> {
+fn trace_events(
+    rec: &Recording,
+    s: &Settings,
+    spectrum: bool,
+) -> Result<(Trace, Option<Spectrogram>)> {
     let hidden = Progress::hidden();
     let o = &s.extract;
-    let (info, events, seq) = sample_file(&rec.path, o.sampling, o.dt_us, &hidden)?;
-    let trace = extract_sequence(&rec.path, info, events, &seq, o, &hidden)?;
+    let sampled = sample_file(&rec.path, o, &hidden)?;
+    let (signal, fs) = (
+        spectrum.then(|| {
+            sampled
+                .seq
+                .values
+                .iter()
+                .map(|&v| v as f64)
+                .collect::<Vec<f64>>()
+        }),
+        sampled.seq.fs(),
+    );
+    let trace = extract_sampled(&rec.path, sampled, o, &hidden)?;
     let f2 = 2.0 * trace.nominal_hz.unwrap_or(o.params.nominal_hz);
-    let spectrogram = spectrum.then(|| {
-        let v: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
-        spectrogram(
-            &v,
-            seq.fs(),
-            o.params.window_s,
-            o.params.step_s,
-            (f2 - 2.0, f2 + 2.0),
-        )
-    });
+    let window_s = trace
+        .events()
+        .map_or(o.params.window_s, |e| e.params.window_s);
+    let spectrogram =
+        signal.map(|v| spectrogram(&v, fs, window_s, o.params.step_s, (f2 - 2.0, f2 + 2.0)));
     Ok((trace, spectrogram))
 }
 
@@ -218,7 +228,6 @@ impl Run {
         out
     }
 }
-
 
 /// Recordings that fit the memory budget at once: the E-ENF sequence and its filtered copies
 /// (~48 bytes a sample at 1/Δt), or a video's row means (2 × 8 bytes a row, up to 1080 rows

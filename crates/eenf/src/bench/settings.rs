@@ -96,4 +96,3 @@ pub fn sweep(base: &Settings, sweeps: &[String]) -> Result<Vec<Settings>> {
     }
     Ok(out)
 }
-

@@ -47,10 +47,13 @@ pub struct TrackerArgs {
 pub struct MethodArgs {
     #[command(flatten)]
     pub tracker: TrackerArgs,
-    /// Temporal sampling: paper (events at the smallest timestamp ≥ t_n), authors (the group
+    /// Temporal sampling: auto (paper when events come in scan groups that share a timestamp,
+    /// as a DVXplorer's; sum when each event has its own, as DVS128, DAVIS and Prophesee
+    /// sensors stamp them), paper (events at the smallest timestamp ≥ t_n), authors (the group
     /// at the largest timestamp in [t_n, t_n + Δt), previous sample when empty), block (vote
-    /// over all events in [t_n, t_n + Δt), the journal version).
-    #[arg(long, default_value = "paper", value_parser = one_of::<SamplingMethod>(&SamplingMethod::NAMES))]
+    /// over all events in [t_n, t_n + Δt), the journal version), sum (ON − OFF count of all
+    /// events in [t_n, t_n + Δt)).
+    #[arg(long, default_value = "auto", value_parser = one_of::<SamplingMethod>(&SamplingMethod::NAMES))]
     pub sampling: SamplingMethod,
     /// Sampling interval Δt, µs.
     #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(i64).range(10..=1_000_000))]
@@ -78,6 +81,31 @@ pub struct MethodArgs {
     /// Agreement tolerance of the consensus rule, Hz (on the ENF scale).
     #[arg(long, default_value_t = HarmonicSelection::DEFAULT_AGREE_HZ)]
     pub agree_hz: f64,
+    #[command(flatten)]
+    pub input: InputArgs,
+}
+
+/// How to read files that leave something open (`info`, `extract`, `convert`, `bench`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct InputArgs {
+    /// The chip of a jAER AEDAT 2.0 file: DVS128, DAVIS240, DAVIS346, DAVIS640 (default: the
+    /// header's `# AEChip:` line, else inferred from the addresses).
+    #[arg(long)]
+    pub chip: Option<String>,
+    /// The camera to read in a file with several (a jAER stereo pair: 0 or 1). Default:
+    /// `extract` takes the one whose flicker stands highest; `info` and `convert` read all.
+    #[arg(long)]
+    pub camera: Option<u8>,
+}
+
+impl InputArgs {
+    /// The reader options.
+    pub fn options(&self) -> eenf_events::OpenOptions {
+        eenf_events::OpenOptions {
+            chip: self.chip.clone(),
+            camera: self.camera,
+        }
+    }
 }
 
 impl TrackerArgs {
@@ -114,6 +142,7 @@ impl MethodArgs {
             dt_us: self.dt_us,
             nominal: self.tracker.nominal,
             params,
+            open: self.input.options(),
         })
     }
 }
@@ -132,7 +161,11 @@ pub struct EventOutputArgs {
 
 impl EventOutputArgs {
     /// The format for `path`: `--format`, else its extension, else `fallback`.
-    pub fn format_for(&self, path: &std::path::Path, fallback: Option<OutputFormat>) -> Result<OutputFormat> {
+    pub fn format_for(
+        &self,
+        path: &std::path::Path,
+        fallback: Option<OutputFormat>,
+    ) -> Result<OutputFormat> {
         let f = match self.format {
             Some(f) => f,
             None => OutputFormat::from_extension(path, self.compression)

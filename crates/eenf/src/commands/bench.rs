@@ -4,8 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use eenf::bench::report::{
-    json_run, markdown_report, markdown_table, write_csv, write_plots, write_traces,
-    ReportContext,
+    json_run, markdown_report, markdown_table, write_csv, write_plots, write_traces, ReportContext,
 };
 use eenf::bench::run::{jobs_for, run_all};
 use eenf::bench::{discover, sweep, Method, Settings};

@@ -7,7 +7,7 @@ use eenf::output::write_events;
 use eenf::progress::Progress;
 use eenf_events::StreamStats;
 
-use super::args::EventOutputArgs;
+use super::args::{EventOutputArgs, InputArgs};
 
 /// Arguments of `eenf convert`.
 #[derive(Debug, clap::Args)]
@@ -18,6 +18,8 @@ pub struct Args {
     pub output: PathBuf,
     #[command(flatten)]
     pub events: EventOutputArgs,
+    #[command(flatten)]
+    pub read: InputArgs,
 }
 
 pub fn run(a: Args, progress: Progress) -> Result<()> {
@@ -26,13 +28,14 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         bail!("{}: input and output are the same file", a.output.display());
     }
     let started = std::time::Instant::now();
-    let mut reader = eenf_events::open(&a.input)?;
+    let open = a.read.options();
+    let mut reader = eenf_events::open_with(&a.input, &open)?;
     let info = reader.info().clone();
     // the output header needs the geometry: from the input's header, else from a first pass
     let (width, height) = match (info.width, info.height) {
         (Some(w), Some(h)) => (w, h),
         _ => {
-            let mut scan = eenf_events::open(&a.input)?;
+            let mut scan = eenf_events::open_with(&a.input, &open)?;
             let s = StreamStats::scan(scan.as_mut())?;
             (
                 s.x_range.map_or(1, |r| r.1.saturating_add(1)),

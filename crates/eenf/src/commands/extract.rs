@@ -38,12 +38,19 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         plot_extraction(p, &title, &trace)?;
     }
     if let Some(x) = trace.events() {
+        for n in &x.notes {
+            eprintln!("note: {n}");
+        }
         eprintln!(
-            "{}: {} events, {:.1} s, {} Hz grid, {} estimates (mean {:.4} Hz) in {took:.2} s ({:.1} M events/s)",
+            "{}: {} events, {:.1} s, {} Hz grid{}, {} sampling, {} estimates (mean {:.4} Hz) in {took:.2} s ({:.1} M events/s)",
             a.file.display(),
             x.events,
             x.duration_s,
             x.params.nominal_hz,
+            x.flicker
+                .map(|l| format!(" (flicker {:.3} Hz, {:.0} dB above the noise)", l.hz, l.db()))
+                .unwrap_or_default(),
+            x.sampling,
             trace.enf_hz.len(),
             trace.mean_hz(),
             x.events as f64 / took / 1e6

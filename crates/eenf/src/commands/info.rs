@@ -3,8 +3,10 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use eenf::inspect::{inspect, CameraFlicker};
 use eenf::time::utc_micros;
-use eenf_events::StreamStats;
+
+use super::args::InputArgs;
 
 /// Arguments of `eenf info`.
 #[derive(Debug, clap::Args)]
@@ -14,13 +16,36 @@ pub struct Args {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub read: InputArgs,
+}
+
+/// `flicker 119.99 Hz (60 Hz grid), 38 dB above the noise`, or why there is none.
+fn flicker_text(f: &CameraFlicker) -> String {
+    let who = f
+        .camera
+        .map(|c| format!("camera {c}: "))
+        .unwrap_or_default();
+    match f.line {
+        Some(l) if l.is_mains() => format!(
+            "{who}{:.3} Hz ({} Hz grid), {:.0} dB above the noise (prominence {:.1})",
+            l.hz,
+            l.grid_hz,
+            l.db(),
+            l.prominence
+        ),
+        Some(l) => format!(
+            "{who}none: the strongest line near 100/120 Hz, {:.3} Hz, stands {:.1}x above the noise",
+            l.hz, l.prominence
+        ),
+        None => format!("{who}not measured (shorter than 1 s)"),
+    }
 }
 
 pub fn run(a: Args) -> Result<()> {
-    let mut reader = eenf_events::open(&a.file)?;
-    let info = reader.info().clone();
-    let stats = StreamStats::scan(reader.as_mut())?;
-    let skipped = reader.skipped();
+    let found = inspect(&a.file, &a.read.options())?;
+    let (info, stats, skipped) = (&found.info, &found.stats, &found.skipped);
+    let sampling = found.grouping.map(|g| g.choice());
     let duration_s = match (stats.first_t, stats.last_t) {
         (Some(f), Some(l)) => (l - f) as f64 * 1e-6,
         _ => 0.0,
@@ -50,6 +75,9 @@ pub fn run(a: Args) -> Result<()> {
             "duration_s": duration_s, "events_per_s": rate,
             "x_range": stats.x_range, "y_range": stats.y_range,
             "skipped": skipped.iter().map(|(k, n)| (k.to_string(), *n)).collect::<std::collections::BTreeMap<_, _>>(),
+            "cameras": info.cameras, "notes": info.notes,
+            "sampling": sampling.as_ref().map(|s| serde_json::json!({"auto": s.0, "why": s.1})),
+            "flicker": found.flicker,
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
@@ -85,6 +113,18 @@ pub fn run(a: Args) -> Result<()> {
         println!("last t      {l} us ({})", utc_micros(l));
         println!("duration    {duration_s:.6} s");
         println!("rate        {:.3} M events/s", rate / 1e6);
+    }
+    if !info.cameras.is_empty() {
+        println!("cameras     {}", info.cameras.join("; "));
+    }
+    if let Some((method, why)) = &sampling {
+        println!("sampling    auto → {method} ({why})");
+    }
+    for f in &found.flicker {
+        println!("flicker     {}", flicker_text(f));
+    }
+    for n in &info.notes {
+        println!("note        {n}");
     }
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! One module per command.
 
+pub mod args;
 pub mod bench;
 pub mod compare;
 pub mod convert;
@@ -7,7 +8,6 @@ pub mod demo;
 pub mod extract;
 pub mod info;
 pub mod matching;
-pub mod args;
 pub mod refdb;
 pub mod reference;
 pub mod simulate;

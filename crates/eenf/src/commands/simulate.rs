@@ -9,7 +9,9 @@ use eenf::simulation::{simulate_recording, EnfSource, Recipe};
 use eenf_events::writers::OutputFormat;
 use eenf_sim::SimConfig;
 
-use super::args::{parse_lamps, parse_readout, parse_resolution, parse_scene, EventOutputArgs, VideoArgs};
+use super::args::{
+    parse_lamps, parse_readout, parse_resolution, parse_scene, EventOutputArgs, VideoArgs,
+};
 
 /// Arguments of `eenf simulate`.
 #[derive(Debug, Clone, clap::Args)]

@@ -1,4 +1,5 @@
 //! Helpers shared by the test targets that need `../shared`.
+#![allow(dead_code)] // each test target uses only some of the helpers
 
 use std::path::PathBuf;
 

@@ -1,0 +1,101 @@
+//! Real recordings that see mains flicker (`shared/fixtures/real-flicker`): old jAER DVS128
+//! files without an `# AEChip:` line, one of them a stereo pair on two clocks. No ENF ground
+//! truth exists; the independent spectral analysis in `shared/fixtures/README.md` gives each
+//! file's flicker line. `#[ignore]`d (needs the shared data); `.ci/run` runs it.
+
+mod cli;
+mod common;
+
+use std::path::PathBuf;
+
+fn real(name: &str) -> PathBuf {
+    common::shared("fixtures/real-flicker")
+        .join("fixtures/real-flicker")
+        .join(name)
+}
+
+/// Traces `file` with the defaults (plus `extra`) and returns the trace's JSON.
+fn extract(file: &std::path::Path, extra: &[&str]) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let mut args = vec!["-q", "extract", file.to_str().unwrap(), "--json"];
+    args.extend_from_slice(extra);
+    let out = cli::ok(&args, dir.path());
+    serde_json::from_str(&out).unwrap()
+}
+
+fn mean(v: &serde_json::Value) -> f64 {
+    let x: Vec<f64> = v["enf_hz"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|x| x.as_f64())
+        .collect();
+    x.iter().sum::<f64>() / x.len() as f64
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn real_dvs128_recordings_are_traced_with_the_defaults() {
+    // (file, camera, the independent analysis' ENF: flicker line / 2)
+    let cases: [(&str, Option<&str>, f64); 3] = [
+        ("jaer_MovingDarkBox.aedat", None, 99.980 / 2.0),
+        (
+            "fhaust_Tmpdiff128StereoPair-vertical-arm.aedat",
+            Some("0"),
+            100.028 / 2.0,
+        ),
+        (
+            "fhaust_Tmpdiff128StereoPair-vertical-arm.aedat",
+            Some("1"),
+            99.937 / 2.0,
+        ),
+    ];
+    for (name, camera, want) in cases {
+        let file = real(name);
+        let extra: Vec<&str> = camera.map(|c| vec!["--camera", c]).unwrap_or_default();
+        let v = extract(&file, &extra);
+        let got = mean(&v);
+        eprintln!("{name} camera {camera:?}: mean {got:.4} Hz, independent {want:.4} Hz");
+        assert_eq!(v["nominal_hz"], 50.0, "{name}: the grid");
+        assert!(
+            (got - want).abs() <= 0.010,
+            "{name} {camera:?}: {got} vs {want}"
+        );
+        // per-event timestamps: every event counts
+        assert_eq!(v["sampling"], "sum", "{name}");
+        assert!(v["enf_hz"].as_array().unwrap().len() >= 30);
+    }
+    // the stereo pair without --camera: one camera, never a mix of both clocks
+    let v = extract(&real("fhaust_Tmpdiff128StereoPair-vertical-arm.aedat"), &[]);
+    let camera = v["camera"].as_u64().expect("a camera is picked");
+    let want = [100.028 / 2.0, 99.937 / 2.0][camera as usize];
+    assert!((mean(&v) - want).abs() <= 0.010, "{} vs {want}", mean(&v));
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn info_reports_the_chip_the_cameras_and_each_flicker_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = real("fhaust_Tmpdiff128StereoPair-vertical-arm.aedat");
+    let out = cli::ok(&["info", f.to_str().unwrap()], dir.path());
+    assert!(
+        out.contains("chip inferred from the addresses as DVS128"),
+        "{out}"
+    );
+    assert!(out.contains("camera 0: 100.028 Hz (50 Hz grid)"), "{out}");
+    assert!(out.contains("camera 1: 99.937 Hz (50 Hz grid)"), "{out}");
+    let f = real("jaer_MovingDarkBox.aedat");
+    let out = cli::ok(&["info", f.to_str().unwrap(), "--json"], dir.path());
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let line = &v["flicker"][0]["line"];
+    // the independent analysis: 99.980 Hz, prominence 19.8
+    assert!(
+        (line["hz"].as_f64().unwrap() - 99.980).abs() < 0.002,
+        "{line}"
+    );
+    assert!(
+        (line["prominence"].as_f64().unwrap() - 19.8).abs() < 1.0,
+        "{line}"
+    );
+    assert_eq!(v["width"], 128);
+}
