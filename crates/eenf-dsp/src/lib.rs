@@ -17,6 +17,8 @@
 //! assert!((trace[20] - 50.01).abs() < 1e-5);
 //! ```
 
+#![forbid(unsafe_code)]
+
 pub mod butter;
 pub mod enf;
 pub mod filtfilt;

@@ -17,6 +17,8 @@
 //! # Ok::<(), eenf_events::EventError>(())
 //! ```
 
+#![forbid(unsafe_code)]
+
 pub mod aedat4;
 mod batch;
 mod error;

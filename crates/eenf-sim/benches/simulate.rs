@@ -1,6 +1,7 @@
 //! Simulation speed: events generated per second (both cores), for a DVXplorer-like readout at
 //! 320×240 under the default LED, under a fluorescent tube, and for a moving hand-held scene.
 //! `EENF_BENCH_SECONDS` sets the simulated length (default 2 s).
+#![allow(missing_docs)] // criterion_group! makes undocumented public functions
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use eenf_sim::{simulate, Lamp, LampKind, MainsPhase, SceneKind, SimConfig, SyntheticEnf};

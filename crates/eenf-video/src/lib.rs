@@ -15,6 +15,8 @@
 //! println!("{} estimates, grid {} Hz", trace.enf_hz.len(), trace.nominal_hz);
 //! ```
 
+#![forbid(unsafe_code)]
+
 use std::path::{Path, PathBuf};
 
 mod source;

@@ -4,6 +4,7 @@
 //! `EENF_SHARED`) when they are there: each day of the year mixes two of them, rotated and
 //! weighted at random, so that no stretch repeats. Without the data, the synthetic
 //! ENF process stands in.
+#![allow(missing_docs)] // criterion_group! makes undocumented public functions
 
 use std::path::PathBuf;
 

@@ -13,6 +13,8 @@
 //! [`trace`] reads and writes traces, [`output`] writes every file whole or not at all,
 //! [`time`] holds all calendar and time-zone work.
 
+#![forbid(unsafe_code)]
+
 pub mod bench;
 pub mod dataset;
 pub mod evaluate;

@@ -1,5 +1,7 @@
 //! `eenf`: Electric Network Frequency from event cameras.
 
+#![forbid(unsafe_code)]
+
 mod commands;
 
 use std::process::ExitCode;

@@ -23,6 +23,20 @@ fn e<T: std::fmt::Debug>(err: T) -> anyhow::Error {
     anyhow!("drawing failed: {err:?}")
 }
 
+/// Registers the bundled font as plotters' `sans-serif` (once per process).
+fn fonts() -> Result<()> {
+    static REGISTERED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let ok = REGISTERED.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
+            .is_ok()
+    });
+    if *ok {
+        Ok(())
+    } else {
+        bail!("the bundled font could not be loaded")
+    }
+}
+
 /// Renders with the backend the extension asks for, through a temporary file.
 fn render(
     path: &Path,
@@ -34,6 +48,7 @@ fn render(
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
+    fonts()?;
     if !matches!(ext.as_str(), "png" | "svg") {
         bail!("{}: plots are written as .png or .svg", path.display());
     }
