@@ -5,7 +5,7 @@ use realfft::RealFftPlanner;
 
 use crate::butter::butter_bandpass;
 use crate::filtfilt::sosfiltfilt;
-use crate::postprocess::{median_correct, select_harmonics, HarmonicSelection};
+use crate::postprocess::{median_correct, select_audible_harmonics, HarmonicSelection};
 use crate::sampling::{PolaritySequence, SamplingError};
 use crate::tracker::{PeakMethod, StftTracker};
 
@@ -179,8 +179,9 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimate
             }
         })
         .collect();
-    let traces = audible(&harmonics, p.segment_len);
-    let (enf_hz, chosen) = select_harmonics(&traces, p.segment_len, p.selection);
+    let traces: Vec<Vec<f64>> = harmonics.iter().map(|h| h.enf_hz.clone()).collect();
+    let audible = audibility(&harmonics, p.segment_len);
+    let (enf_hz, chosen) = select_audible_harmonics(&traces, &audible, p.segment_len, p.selection);
     if enf_hz.iter().all(|v| !v.is_finite()) {
         return Err(DspError::NoTone("the flicker bands hold no signal".into()));
     }
@@ -205,38 +206,26 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimate
 }
 
 /// A band's line must stand this far above its noise (mean over a selection segment, dB) for
-/// the selection to take it there. Noise alone peaks at about 8 dB over the band's median.
+/// the selection to take it there while another band's does. Noise alone peaks at about 8 dB
+/// over the band's median power.
 pub const MIN_BAND_SNR_DB: f64 = 12.0;
 
-/// The harmonic traces as the selection may use them: in each segment, a band whose line does
-/// not stand [`MIN_BAND_SNR_DB`] above its noise is blanked (NaN), unless no band does, when
-/// only the strongest is kept.
-fn audible(harmonics: &[HarmonicEstimates], segment: usize) -> Vec<Vec<f64>> {
-    let mut traces: Vec<Vec<f64>> = harmonics.iter().map(|h| h.enf_hz.clone()).collect();
-    let n = traces.iter().map(|t| t.len()).min().unwrap_or(0);
-    for start in (0..n).step_by(segment.max(1)) {
-        let end = (start + segment.max(1)).min(n);
-        let mean: Vec<f64> = harmonics
-            .iter()
-            .map(|h| {
-                let v: Vec<f64> = h.snr_db[start..end]
-                    .iter()
-                    .copied()
-                    .filter(|s| s.is_finite())
-                    .collect();
-                v.iter().sum::<f64>() / v.len().max(1) as f64
-            })
-            .collect();
-        let best = (0..mean.len())
-            .max_by(|&a, &b| mean[a].total_cmp(&mean[b]))
-            .unwrap_or(0);
-        for (k, t) in traces.iter_mut().enumerate() {
-            if mean[k] < MIN_BAND_SNR_DB && k != best {
-                t[start..end].iter_mut().for_each(|v| *v = f64::NAN);
-            }
-        }
-    }
-    traces
+/// For each harmonic and selection segment: does the band's line stand [`MIN_BAND_SNR_DB`]
+/// above its noise there?
+fn audibility(harmonics: &[HarmonicEstimates], segment: usize) -> Vec<Vec<bool>> {
+    let segment = segment.max(1);
+    harmonics
+        .iter()
+        .map(|h| {
+            h.snr_db
+                .chunks(segment)
+                .map(|c| {
+                    let v: Vec<f64> = c.iter().copied().filter(|s| s.is_finite()).collect();
+                    !v.is_empty() && v.iter().sum::<f64>() / v.len() as f64 >= MIN_BAND_SNR_DB
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// The reference ENF of a mains (or audio) signal: the same tracker at the fundamental f0,

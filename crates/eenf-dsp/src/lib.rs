@@ -38,7 +38,9 @@ pub use enf::{
 pub use filtfilt::sosfiltfilt;
 pub use flicker::{flicker_line, flicker_lines, FlickerLine, MIN_FLICKER_PROMINENCE};
 pub use metrics::{agreement, Agreement};
-pub use postprocess::{median_correct, select_harmonics, HarmonicSelection};
+pub use postprocess::{
+    median_correct, select_audible_harmonics, select_harmonics, HarmonicSelection,
+};
 pub use sampling::{Grouping, PolaritySequence, SamplingError, SamplingMethod, TemporalSampler};
 pub use spectrogram::{spectrogram, Spectrogram};
 pub use tracker::{PeakMethod, StftTracker};

@@ -78,6 +78,19 @@ pub fn select_harmonics(
     segment: usize,
     rule: HarmonicSelection,
 ) -> (Vec<f64>, Vec<usize>) {
+    select_audible_harmonics(traces, &[], segment, rule)
+}
+
+/// [`select_harmonics`], taking in each segment only the traces marked audible there
+/// (`audible[trace][segment]`; a missing mark counts as audible) when any of the rule's picks,
+/// or any trace at all, is: a band whose line does not stand above its noise is never taken
+/// where another does.
+pub fn select_audible_harmonics(
+    traces: &[Vec<f64>],
+    audible: &[Vec<bool>],
+    segment: usize,
+    rule: HarmonicSelection,
+) -> (Vec<f64>, Vec<usize>) {
     let n = traces.iter().map(|t| t.len()).min().unwrap_or(0);
     let segment = segment.max(1);
     let mut out = Vec::with_capacity(n);
@@ -108,6 +121,23 @@ pub fn select_harmonics(
             if best > 0 {
                 candidates.retain(|&a| scores[a] == best);
             }
+        }
+        let heard = |a: &usize| {
+            audible
+                .get(*a)
+                .and_then(|m| m.get(start / segment))
+                .copied()
+                .unwrap_or(true)
+        };
+        if !candidates.iter().any(heard) {
+            // the rule's picks are all noise: any audible trace instead
+            let others: Vec<usize> = (0..traces.len()).filter(|a| heard(a)).collect();
+            if !others.is_empty() {
+                candidates = others;
+            }
+        }
+        if candidates.iter().any(heard) {
+            candidates.retain(heard);
         }
         let pick = candidates
             .iter()
@@ -174,5 +204,30 @@ mod tests {
         // a single trace is taken as it is
         let (out, c) = select_harmonics(&traces[2..], 10, HarmonicSelection::Consensus(0.005));
         assert_eq!((out[0], c[0]), (50.15, 0));
+    }
+
+    #[test]
+    fn a_flat_band_locked_on_noise_is_not_taken_where_another_is_heard() {
+        // band 0 follows the ENF; band 1 locked onto noise is flat (the smoothest); band 2 wanders
+        let real: Vec<f64> = (0..20).map(|i| 50.0 + 0.002 * i as f64).collect();
+        let flat = vec![49.9; 20];
+        let wild: Vec<f64> = (0..20).map(|i| 50.1 + 0.05 * (i % 3) as f64).collect();
+        let traces = [real.clone(), flat.clone(), wild];
+        let (_, picked) = select_harmonics(&traces, 10, HarmonicSelection::Smoothest);
+        assert_eq!(picked, vec![1, 1], "the paper's rule takes the flat band");
+        let heard = [vec![true, true], vec![false, false], vec![false, true]];
+        for rule in [
+            HarmonicSelection::Smoothest,
+            HarmonicSelection::Consensus(0.005),
+        ] {
+            let (out, picked) = select_audible_harmonics(&traces, &heard, 10, rule);
+            assert_eq!(picked, vec![0, 0], "{rule:?}");
+            assert_eq!(out, real);
+        }
+        // where nothing is heard, the rule decides as before
+        let none = [vec![false; 2], vec![false; 2], vec![false; 2]];
+        let (_, picked) =
+            select_audible_harmonics(&traces, &none, 10, HarmonicSelection::Smoothest);
+        assert_eq!(picked, vec![1, 1]);
     }
 }

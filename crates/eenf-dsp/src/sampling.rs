@@ -44,6 +44,9 @@ pub struct Grouping {
     pub events_per_timestamp: f64,
     /// Median step between distinct timestamps, µs.
     pub median_step_us: f64,
+    /// Share of the steps shorter than a quarter of the median: none on a scan clock (no two
+    /// scans closer than a scan period), about 16 % for events at random at any rate.
+    pub short_share: f64,
 }
 
 impl Grouping {
@@ -65,25 +68,35 @@ impl Grouping {
             let k = steps.len() / 2;
             *steps.select_nth_unstable(k).1 as f64
         };
+        let short = steps
+            .iter()
+            .filter(|&&d| (d as f64) < 0.25 * median)
+            .count();
+        let short_share = short as f64 / steps.len().max(1) as f64;
         Grouping {
             events: t.len(),
             events_per_timestamp: t.len() as f64 / distinct.max(1) as f64,
             median_step_us: median,
+            short_share,
         }
     }
 
-    /// Scan groups: several events per timestamp, and timestamps a scan apart (a DVXplorer
-    /// reads its array every ~200 µs). Dense µs-stamped streams share timestamps too, but 1 µs
-    /// apart; sparse ones neither.
+    /// Scan groups: timestamps a scan apart (a DVXplorer reads its array every ~200 µs), with
+    /// several events per timestamp, or never closer than a scan when a quiet scene leaves a
+    /// scan only an event or two. Dense µs-stamped streams share timestamps too, but 1 µs
+    /// apart; sparse ones come at random, and a sixth of their steps are short.
     pub fn is_scanned(&self) -> bool {
-        self.events_per_timestamp >= 8.0 && self.median_step_us >= 20.0
+        self.median_step_us >= 20.0 && (self.events_per_timestamp >= 8.0 || self.short_share < 0.03)
     }
 
     /// The sampling `auto` picks, and why, in words.
     pub fn choice(&self) -> (SamplingMethod, String) {
         let measured = format!(
-            "{:.1} events per timestamp, timestamps {:.0} µs apart (median) in the first {} events",
-            self.events_per_timestamp, self.median_step_us, self.events
+            "{:.1} events per timestamp, {:.0} µs apart (median), {:.0} % of the steps under a quarter of that, in the first {} events",
+            self.events_per_timestamp,
+            self.median_step_us,
+            100.0 * self.short_share,
+            self.events
         );
         if self.is_scanned() {
             (SamplingMethod::Paper, format!("scan groups: {measured}"))
@@ -480,8 +493,22 @@ mod tests {
         };
         // a DVXplorer: hundreds of events per 200 µs scan
         assert_eq!(pick(&stream(500, 300, 200)), SamplingMethod::Paper);
-        // a DVS128: one event every ~80 µs
-        assert_eq!(pick(&stream(5000, 1, 80)), SamplingMethod::Sum);
+        // a quiet DVXplorer: a couple of events per scan, still on the scan clock
+        assert_eq!(pick(&stream(5000, 2, 200)), SamplingMethod::Paper);
+        // a DVS128: events at random, ~80 µs apart on average
+        let mut b = EventBatch::default();
+        let (mut t, mut s) = (0i64, 0x9e37_79b9_7f4a_7c15u64);
+        for k in 0..20_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let u = ((s >> 11) as f64 + 1.0) / (1u64 << 53) as f64;
+            t += (-80.0 * u.ln()).round() as i64;
+            b.push(t, 0, 0, k % 2 == 0);
+        }
+        let g = Grouping::measure(&b.t);
+        assert!((0.1..0.25).contains(&g.short_share), "{g:?}");
+        assert_eq!(pick(&b), SamplingMethod::Sum);
         // a busy Prophesee sensor: ten events in every µs
         assert_eq!(pick(&stream(20_000, 10, 1)), SamplingMethod::Sum);
         // the paper's sampler on such a stream would vote with one timestamp's few events
