@@ -45,20 +45,12 @@ impl FlickerLine {
     }
 }
 
-/// The stronger of the two [`flicker_lines`].
-pub fn flicker_line(x: &[f64], fs: f64) -> Option<FlickerLine> {
-    let [a, b] = flicker_lines(x, fs)?;
-    Some(if a.prominence >= b.prominence { a } else { b })
-}
-
-/// The strongest line near 100 Hz (a 50 Hz grid) and near 120 Hz (60 Hz) in `x` sampled at
-/// `fs` (at least 300 Hz; at least one second of signal). `None` when the signal is too short
-/// or too slow.
-pub fn flicker_lines(x: &[f64], fs: f64) -> Option<[FlickerLine; 2]> {
+/// The magnitude spectrum of `x` under a Hann window, zero-padded four times (at most 2^24
+/// points), its bin width, and its median magnitude in [`NOISE_BAND`].
+fn spectrum(x: &[f64], fs: f64) -> Option<(Vec<f64>, f64, f64)> {
     if fs < 2.0 * NOISE_BAND.1 + 20.0 || (x.len() as f64) < fs {
         return None;
     }
-    // zero-padded four times (at most 2^24 points): bins of a quarter of the resolution
     let nfft = (4 * x.len())
         .next_power_of_two()
         .min(1 << 24)
@@ -74,11 +66,39 @@ pub fn flicker_lines(x: &[f64], fs: f64) -> Option<[FlickerLine; 2]> {
     let mut spec = fft.make_output_vec();
     fft.process(&mut input, &mut spec).ok()?;
     let df = fs / nfft as f64;
-    let bin = |f: f64| ((f / df).round() as usize).min(spec.len() - 1);
     let mag: Vec<f64> = spec.iter().map(|c| c.norm()).collect();
+    let bin = |f: f64| ((f / df).round() as usize).min(mag.len() - 1);
     let mut noise: Vec<f64> = mag[bin(NOISE_BAND.0)..=bin(NOISE_BAND.1)].to_vec();
     let k = noise.len() / 2;
     let median = *noise.select_nth_unstable_by(k, f64::total_cmp).1;
+    Some((mag, df, median))
+}
+
+/// How far `x` stands above its noise at `hz` (a line found elsewhere, e.g. over the whole
+/// sensor): its magnitude there (the largest within one resolution cell) over the median
+/// magnitude in 80–140 Hz. About 1 where there is no line.
+pub fn line_strength_at(x: &[f64], fs: f64, hz: f64) -> Option<f64> {
+    let (mag, df, median) = spectrum(x, fs)?;
+    let cell = (4.0 * fs / x.len() as f64 / df).ceil() as usize / 4;
+    let k = ((hz / df).round() as usize).min(mag.len() - 1);
+    let peak = mag[k.saturating_sub(cell)..=(k + cell).min(mag.len() - 1)]
+        .iter()
+        .fold(0.0f64, |a, &b| a.max(b));
+    (median > 0.0).then(|| peak / median)
+}
+
+/// The stronger of the two [`flicker_lines`].
+pub fn flicker_line(x: &[f64], fs: f64) -> Option<FlickerLine> {
+    let [a, b] = flicker_lines(x, fs)?;
+    Some(if a.prominence >= b.prominence { a } else { b })
+}
+
+/// The strongest line near 100 Hz (a 50 Hz grid) and near 120 Hz (60 Hz) in `x` sampled at
+/// `fs` (at least 300 Hz; at least one second of signal). `None` when the signal is too short
+/// or too slow.
+pub fn flicker_lines(x: &[f64], fs: f64) -> Option<[FlickerLine; 2]> {
+    let (mag, df, median) = spectrum(x, fs)?;
+    let bin = |f: f64| ((f / df).round() as usize).min(mag.len() - 1);
     let peak = |(lo, hi): (f64, f64)| {
         let (a, b) = (bin(lo), bin(hi));
         let (i, m) =
@@ -165,5 +185,29 @@ mod tests {
         assert_eq!(fifty.grid_hz, 50.0);
         assert!((fifty.hz - 99.98).abs() < 0.005, "{fifty:?}");
         assert!(flicker_line(&noise[..500], fs).is_none());
+    }
+
+    #[test]
+    fn line_strength_is_read_where_the_line_is_and_about_one_elsewhere() {
+        let fs = 500.0;
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut noise = || {
+            (0..12)
+                .map(|_| {
+                    seed ^= seed << 13;
+                    seed ^= seed >> 7;
+                    seed ^= seed << 17;
+                    (seed >> 11) as f64 / (1u64 << 53) as f64
+                })
+                .sum::<f64>()
+                - 6.0
+        };
+        let x: Vec<f64> = (0..20_000)
+            .map(|i| noise() + 0.3 * (2.0 * std::f64::consts::PI * 100.02 * i as f64 / fs).sin())
+            .collect();
+        let at = line_strength_at(&x, fs, 100.02).unwrap();
+        let off = line_strength_at(&x, fs, 117.3).unwrap();
+        assert!(at > 10.0, "{at}");
+        assert!((0.3..3.5).contains(&off), "{off}");
     }
 }

@@ -36,7 +36,9 @@ pub use enf::{
     DspError, EnfEstimates, EnfParams, HarmonicEstimates,
 };
 pub use filtfilt::sosfiltfilt;
-pub use flicker::{flicker_line, flicker_lines, FlickerLine, MIN_FLICKER_PROMINENCE};
+pub use flicker::{
+    flicker_line, flicker_lines, line_strength_at, FlickerLine, MIN_FLICKER_PROMINENCE,
+};
 pub use metrics::{agreement, Agreement};
 pub use postprocess::{
     median_correct, select_audible_harmonics, select_harmonics, HarmonicSelection,

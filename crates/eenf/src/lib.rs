@@ -19,6 +19,7 @@ pub mod bench;
 pub mod dataset;
 pub mod evaluate;
 pub mod extract;
+pub mod flicker_map;
 pub mod inspect;
 pub mod output;
 pub mod plot;

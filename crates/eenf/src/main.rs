@@ -31,6 +31,8 @@ enum Command {
     Convert(commands::convert::Args),
     /// Extract the ENF trace from an event recording (E-ENF).
     Extract(commands::extract::Args),
+    /// Map where in the view the mains flicker is: its line's strength per tile of pixels.
+    FlickerMap(commands::flicker_map::Args),
     /// Build the reference ENF trace from a mains/audio WAV recording.
     Reference(commands::reference::Args),
     /// Compare an ENF trace with a reference: CC, MAE, RMSE, max error.
@@ -61,6 +63,7 @@ fn main() -> ExitCode {
         Command::Info(a) => commands::info::run(a),
         Command::Convert(a) => commands::convert::run(a, progress),
         Command::Extract(a) => commands::extract::run(a, progress),
+        Command::FlickerMap(a) => commands::flicker_map::run(a, progress),
         Command::Reference(a) => commands::reference::run(a, progress),
         Command::Compare(a) => commands::compare::run(a, progress),
         Command::Refdb(c) => commands::refdb::run(c, progress),

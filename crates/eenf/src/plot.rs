@@ -636,3 +636,99 @@ pub fn plot_extraction(path: &Path, title: &str, trace: &Trace) -> Result<()> {
         |root| extraction(root, title, trace),
     )
 }
+
+fn flicker_map_chart<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    m: &crate::flicker_map::FlickerMap,
+) -> Result<()> {
+    root.fill(&WHITE).map_err(e)?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(e)?;
+    let (plot_area, bar_area) = root.split_horizontally(SIZE.0 as i32 - 120);
+    let (w, h) = (m.width as f64, m.height as f64);
+    let mut c = ChartBuilder::on(&plot_area)
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        // rows from the top, as the sensor's pixels
+        .build_cartesian_2d(0.0..w, h..0.0)
+        .map_err(e)?;
+    c.configure_mesh()
+        .disable_mesh()
+        .x_desc("x (pixels)")
+        .y_desc("y (pixels)")
+        .draw()
+        .map_err(e)?;
+    let db = |s: f64| 20.0 * s.max(1e-9).log10();
+    let top_db = m
+        .strength
+        .iter()
+        .flatten()
+        .map(|&s| db(s))
+        .fold(20.0, f64::max);
+    let t = m.tile as f64;
+    c.draw_series((0..m.rows).flat_map(|r| {
+        (0..m.cols).map(move |k| {
+            let colour = match m.strength[r * m.cols + k] {
+                Some(s) => heat(db(s) / top_db),
+                None => RGBColor(200, 200, 200),
+            };
+            let (x0, y0) = (k as f64 * t, r as f64 * t);
+            Rectangle::new(
+                [(x0, y0), ((x0 + t).min(w), (y0 + t).min(h))],
+                colour.filled(),
+            )
+        })
+    }))
+    .map_err(e)?;
+    // the tiles where the line stands above the noise, outlined
+    c.draw_series(m.flickering().map(|i| {
+        let (r, k) = (i / m.cols, i % m.cols);
+        let (x0, y0) = (k as f64 * t, r as f64 * t);
+        Rectangle::new(
+            [(x0, y0), ((x0 + t).min(w), (y0 + t).min(h))],
+            WHITE.stroke_width(1),
+        )
+    }))
+    .map_err(e)?;
+    let mut b = ChartBuilder::on(&bar_area)
+        .margin(12)
+        .margin_left(4)
+        .x_label_area_size(40)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..1.0, 0.0..top_db)
+        .map_err(e)?;
+    b.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .y_desc("line over noise (dB)")
+        .draw()
+        .map_err(e)?;
+    let steps = 64;
+    b.draw_series((0..steps).map(|k| {
+        let lo = top_db * k as f64 / steps as f64;
+        let hi = top_db * (k + 1) as f64 / steps as f64;
+        Rectangle::new(
+            [(0.0, lo), (1.0, hi)],
+            heat(k as f64 / steps as f64).filled(),
+        )
+    }))
+    .map_err(e)?;
+    Ok(())
+}
+
+/// The flicker map: each tile coloured by how far its line stands above its noise (grey: too
+/// few events), the tiles where it counts as mains flicker outlined in white.
+pub fn plot_flicker_map(
+    path: &Path,
+    title: &str,
+    map: &crate::flicker_map::FlickerMap,
+) -> Result<()> {
+    render(
+        path,
+        |root| flicker_map_chart(root, title, map),
+        |root| flicker_map_chart(root, title, map),
+    )
+}

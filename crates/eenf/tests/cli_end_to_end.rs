@@ -265,3 +265,46 @@ fn refdb_and_match_locate_a_clip() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("no 60 Hz grid"));
 }
+
+#[test]
+fn the_flicker_map_of_a_lamp_lit_room_flickers_everywhere() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    eenf(
+        &[
+            "-q",
+            "simulate",
+            "--duration",
+            "8",
+            "--resolution",
+            "32x24",
+            "-o",
+            "room.aedat4",
+        ],
+        d,
+    );
+    let map = json(&eenf(
+        &[
+            "-q",
+            "flicker-map",
+            "room.aedat4",
+            "-o",
+            "map.svg",
+            "--tile",
+            "8",
+            "--json",
+        ],
+        d,
+    ));
+    assert_eq!(
+        (map["cols"].as_u64(), map["rows"].as_u64()),
+        (Some(4), Some(3))
+    );
+    let line = &map["whole"];
+    assert!((line["hz"].as_f64().unwrap() - 100.0).abs() < 0.2, "{line}");
+    // every pixel sees the lamp: every tile's line stands out
+    for s in map["strength"].as_array().unwrap() {
+        assert!(s.as_f64().unwrap() > 10.0, "{s}");
+    }
+    assert!(d.join("map.svg").metadata().unwrap().len() > 1000);
+}

@@ -99,3 +99,38 @@ fn info_reports_the_chip_the_cameras_and_each_flicker_line() {
     );
     assert_eq!(v["width"], 128);
 }
+
+#[test]
+#[ignore = "needs ../shared"]
+fn the_flicker_map_finds_the_lit_patch() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = real("jaer_MovingDarkBox.aedat");
+    let out = cli::ok(
+        &[
+            "-q",
+            "flicker-map",
+            f.to_str().unwrap(),
+            "-o",
+            "map.png",
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert!(dir.path().join("map.png").metadata().unwrap().len() > 10_000);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let cols = v["cols"].as_u64().unwrap() as usize;
+    let strength: Vec<f64> = v["strength"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_f64().unwrap_or(0.0))
+        .collect();
+    let lit: Vec<usize> = (0..strength.len())
+        .filter(|&k| strength[k] >= 3.5)
+        .collect();
+    // a patch, not the whole view: a few percent of the tiles, most of them in its rows
+    assert!((5..=100).contains(&lit.len()), "{}", lit.len());
+    let tile = v["tile"].as_u64().unwrap() as usize;
+    let low = lit.iter().filter(|&&k| (k / cols) * tile >= 84).count();
+    assert!(low * 2 > lit.len(), "{low} of {} below row 84", lit.len());
+}

@@ -6,6 +6,7 @@ pub mod compare;
 pub mod convert;
 pub mod demo;
 pub mod extract;
+pub mod flicker_map;
 pub mod info;
 pub mod matching;
 pub mod refdb;

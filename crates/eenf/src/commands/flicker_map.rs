@@ -1,0 +1,55 @@
+//! `eenf flicker-map`: where in the view the mains flicker is.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use eenf::flicker_map::{flicker_map, MAP_SECONDS};
+use eenf::plot::plot_flicker_map;
+use eenf::progress::Progress;
+
+use super::args::InputArgs;
+
+/// Arguments of `eenf flicker-map`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The event recording.
+    pub file: PathBuf,
+    /// The picture (.png or .svg).
+    #[arg(short, long, default_value = "flicker-map.png")]
+    pub output: PathBuf,
+    /// Tile side, pixels (default: at most 32 tiles across).
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+    pub tile: Option<u16>,
+    /// Print the map (every tile's line) as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub read: InputArgs,
+}
+
+pub fn run(a: Args, progress: Progress) -> Result<()> {
+    let map = flicker_map(&a.file, &a.read.options(), a.tile, &progress)?;
+    let whole = match map.whole {
+        Some(l) => format!("{:.3} Hz, {:.0} dB over the whole sensor", l.hz, l.db()),
+        None => "no line measured".to_string(),
+    };
+    let share = 100.0 * map.flickering_share();
+    let title = format!(
+        "{}: flicker {whole}; {share:.0} % of the tiles",
+        a.file.file_name().unwrap_or_default().to_string_lossy()
+    );
+    plot_flicker_map(&a.output, &title, &map)?;
+    eprintln!(
+        "{}: {} x {} tiles of {} pixels over {:.1} s (at most {MAP_SECONDS} s): flicker {whole}; it stands out in {share:.0} % of the tiles",
+        a.file.display(),
+        map.cols,
+        map.rows,
+        map.tile,
+        map.seconds
+    );
+    eprintln!("map written to {}", a.output.display());
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&map)?);
+    }
+    Ok(())
+}

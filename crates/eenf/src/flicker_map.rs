@@ -1,0 +1,145 @@
+//! Where the flicker is: the mains line's strength in each tile of pixels, a picture in which a
+//! person sees the lamp and the surfaces it lights.
+
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use eenf_dsp::{flicker_lines, line_strength_at, FlickerLine};
+use eenf_events::OpenOptions;
+use rayon::prelude::*;
+
+use crate::progress::Progress;
+
+/// Seconds of the recording the map looks at (the line is steady; memory stays bounded).
+pub const MAP_SECONDS: f64 = 64.0;
+/// Bin of the tiles' ON − OFF sums, µs: 500 Hz sampling keeps 80–140 Hz below Nyquist.
+const BIN_US: i64 = 2000;
+/// Tiles across the longer side of the sensor, at most.
+const MAX_TILES: u16 = 32;
+/// A tile flickers when the recording's line stands this many times above the tile's noise
+/// (11 dB; tiles of noise alone reach about 10 dB at most on the real recordings).
+pub const MIN_TILE_STRENGTH: f64 = 3.5;
+
+/// The flicker line in each tile of a recording.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct FlickerMap {
+    /// Sensor width and height, pixels.
+    pub width: u16,
+    /// See `width`.
+    pub height: u16,
+    /// Tile side, pixels.
+    pub tile: u16,
+    /// Tiles across and down.
+    pub cols: usize,
+    /// See `cols`.
+    pub rows: usize,
+    /// Events in each tile (row-major).
+    pub events: Vec<u64>,
+    /// In each tile (row-major), the magnitude at the whole sensor's line over the tile's
+    /// noise (`None`: too few events, or no line over the whole sensor).
+    pub strength: Vec<Option<f64>>,
+    /// The whole sensor's line.
+    pub whole: Option<FlickerLine>,
+    /// Seconds looked at.
+    pub seconds: f64,
+}
+
+impl FlickerMap {
+    /// Tiles whose line stands above the noise, as a share of all tiles.
+    pub fn flickering_share(&self) -> f64 {
+        let n = self.flickering().count();
+        n as f64 / self.strength.len().max(1) as f64
+    }
+
+    /// The tiles (row-major indices) where the line stands out.
+    pub fn flickering(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.strength.len())
+            .filter(|&k| self.strength[k].is_some_and(|s| s >= MIN_TILE_STRENGTH))
+    }
+}
+
+/// Maps the flicker of the file at `path` (read as `open` says) over its first
+/// [`MAP_SECONDS`]: tiles of `tile` pixels (default: at most 32 tiles across).
+pub fn flicker_map(
+    path: &Path,
+    open: &OpenOptions,
+    tile: Option<u16>,
+    progress: &Progress,
+) -> Result<FlickerMap> {
+    let mut reader = eenf_events::open_with(path, open)?;
+    let info = reader.info().clone();
+    let (Some(width), Some(height)) = (info.width, info.height) else {
+        bail!(
+            "{}: the header gives no sensor size to lay tiles on",
+            path.display()
+        );
+    };
+    let tile = tile
+        .unwrap_or_else(|| width.max(height).div_ceil(MAX_TILES))
+        .max(1);
+    let (cols, rows) = (
+        width.div_ceil(tile) as usize,
+        height.div_ceil(tile) as usize,
+    );
+    let bins = (MAP_SECONDS * 1e6 / BIN_US as f64) as usize;
+    // ON − OFF per tile and bin, tile-major
+    let mut sums = vec![0i16; cols * rows * bins];
+    let mut whole = vec![0i32; bins];
+    let mut events = vec![0u64; cols * rows];
+    let mut t0 = None;
+    let mut last_bin = 0usize;
+    let bar = progress.events(info.event_count, "mapping the flicker");
+    'read: while let Some(b) = reader.next_batch()? {
+        let start = *t0.get_or_insert(b.t.first().copied().unwrap_or(0));
+        for i in 0..b.len() {
+            let bin = (b.t[i] - start).max(0) / BIN_US;
+            if bin as usize >= bins {
+                break 'read;
+            }
+            let bin = bin as usize;
+            last_bin = last_bin.max(bin);
+            let (x, y) = (b.x[i] / tile, b.y[i] / tile);
+            if x as usize >= cols || y as usize >= rows {
+                continue;
+            }
+            let k = y as usize * cols + x as usize;
+            let v: i16 = if b.p[i] { 1 } else { -1 };
+            let s = &mut sums[k * bins + bin];
+            *s = s.saturating_add(v);
+            whole[bin] += i32::from(v);
+            events[k] += 1;
+        }
+        bar.inc(b.len() as u64);
+    }
+    bar.finish_and_clear();
+    let used = last_bin + 1;
+    let fs = 1e6 / BIN_US as f64;
+    let whole_x: Vec<f64> = whole[..used].iter().map(|&v| v as f64).collect();
+    let whole_line =
+        flicker_lines(&whole_x, fs).map(|[a, b]| if a.prominence >= b.prominence { a } else { b });
+    let strength: Vec<Option<f64>> = (0..cols * rows)
+        .into_par_iter()
+        .map(|k| {
+            let line = whole_line?;
+            if events[k] < 100 {
+                return None;
+            }
+            let x: Vec<f64> = sums[k * bins..k * bins + used]
+                .iter()
+                .map(|&v| v as f64)
+                .collect();
+            line_strength_at(&x, fs, line.hz)
+        })
+        .collect();
+    Ok(FlickerMap {
+        width,
+        height,
+        tile,
+        cols,
+        rows,
+        events,
+        strength,
+        whole: whole_line,
+        seconds: used as f64 / fs,
+    })
+}
