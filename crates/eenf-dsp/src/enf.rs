@@ -52,7 +52,7 @@ impl Default for EnfParams {
             median_len: 21,
             median_threshold_hz: 0.02,
             segment_len: 10,
-            selection: HarmonicSelection::Consensus(0.005),
+            selection: HarmonicSelection::Journal(HarmonicSelection::DEFAULT_JUMP_HZ),
         }
     }
 }
@@ -185,7 +185,11 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimate
     if enf_hz.iter().all(|v| !v.is_finite()) {
         return Err(DspError::NoTone("the flicker bands hold no signal".into()));
     }
-    let seg = p.segment_len.max(1);
+    // the journal rule chooses per estimate
+    let seg = match p.selection {
+        HarmonicSelection::Journal(_) => 1,
+        _ => p.segment_len.max(1),
+    };
     let snr_db = (0..enf_hz.len())
         .map(|i| {
             harmonics[chosen[i / seg]]
@@ -201,7 +205,7 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimate
         snr_db,
         selected: chosen.iter().map(|&i| harmonics[i].harmonic).collect(),
         harmonics,
-        segment_len: p.segment_len,
+        segment_len: seg,
     })
 }
 

@@ -41,13 +41,19 @@ pub enum HarmonicSelection {
     /// tolerance, Hz, on the ENF scale) for the most estimates of the segment. A band that
     /// locked onto noise is flat after outlier correction, so the paper's rule alone prefers it.
     Consensus(f64),
+    /// The journal version's fine-tuning: follow the 2f0 band, and where its estimate jumps by
+    /// more than the tolerance (Hz, on the ENF scale) from the trace so far or is missing,
+    /// take the harmonic's estimate that keeps the trace smoothest there. Chosen per estimate.
+    Journal(f64),
 }
 
 impl HarmonicSelection {
     /// Every rule, by its command-line name.
-    pub const NAMES: [&'static str; 2] = ["smoothest", "consensus"];
+    pub const NAMES: [&'static str; 3] = ["smoothest", "consensus", "journal"];
     /// The consensus rule's default tolerance, Hz.
     pub const DEFAULT_AGREE_HZ: f64 = 0.005;
+    /// The journal rule's default jump, Hz per estimate (the grid moves ~1 mHz a second).
+    pub const DEFAULT_JUMP_HZ: f64 = 0.005;
 }
 
 impl std::fmt::Display for HarmonicSelection {
@@ -55,6 +61,7 @@ impl std::fmt::Display for HarmonicSelection {
         f.write_str(match self {
             HarmonicSelection::Smoothest => "smoothest",
             HarmonicSelection::Consensus(_) => "consensus",
+            HarmonicSelection::Journal(_) => "journal",
         })
     }
 }
@@ -66,7 +73,8 @@ impl std::str::FromStr for HarmonicSelection {
         match s {
             "smoothest" => Ok(HarmonicSelection::Smoothest),
             "consensus" => Ok(HarmonicSelection::Consensus(Self::DEFAULT_AGREE_HZ)),
-            _ => Err(format!("{s:?}: expected smoothest or consensus")),
+            "journal" => Ok(HarmonicSelection::Journal(Self::DEFAULT_JUMP_HZ)),
+            _ => Err(format!("{s:?}: expected smoothest, consensus or journal")),
         }
     }
 }
@@ -91,6 +99,9 @@ pub fn select_audible_harmonics(
     segment: usize,
     rule: HarmonicSelection,
 ) -> (Vec<f64>, Vec<usize>) {
+    if let HarmonicSelection::Journal(jump) = rule {
+        return follow_2f0(traces, jump);
+    }
     let n = traces.iter().map(|t| t.len()).min().unwrap_or(0);
     let segment = segment.max(1);
     let mut out = Vec::with_capacity(n);
@@ -146,6 +157,40 @@ pub fn select_audible_harmonics(
             .unwrap_or(0);
         chosen.push(pick);
         out.extend_from_slice(&traces[pick][start..end]);
+    }
+    (out, chosen)
+}
+
+/// The journal rule: the first trace (the 2f0 band) where it continues the trace, else the
+/// trace whose estimate is closest to the last one taken. Returns the trace and the index of
+/// the band taken at every estimate.
+fn follow_2f0(traces: &[Vec<f64>], jump: f64) -> (Vec<f64>, Vec<usize>) {
+    let n = traces.iter().map(|t| t.len()).min().unwrap_or(0);
+    let mut out = Vec::with_capacity(n);
+    let mut chosen = Vec::with_capacity(n);
+    let mut last: Option<f64> = None;
+    for i in 0..n {
+        let base = traces.first().map_or(f64::NAN, |t| t[i]);
+        let pick = match last {
+            Some(prev) if !(base.is_finite() && (base - prev).abs() <= jump) => (0..traces.len())
+                .filter(|&k| traces[k][i].is_finite())
+                .min_by(|&a, &b| {
+                    (traces[a][i] - prev)
+                        .abs()
+                        .total_cmp(&(traces[b][i] - prev).abs())
+                })
+                .unwrap_or(0),
+            None if !base.is_finite() => (0..traces.len())
+                .find(|&k| traces[k][i].is_finite())
+                .unwrap_or(0),
+            _ => 0,
+        };
+        let v = traces.get(pick).map_or(f64::NAN, |t| t[i]);
+        if v.is_finite() {
+            last = Some(v);
+        }
+        out.push(v);
+        chosen.push(pick);
     }
     (out, chosen)
 }

@@ -19,7 +19,8 @@ pub enum SamplingMethod {
     /// stamp events one by one (DVS128, DAVIS, Prophesee) need.
     Sum,
     /// Chooses from the stream: `paper` when events come in scan groups that share a timestamp
-    /// (DVXplorer), `sum` otherwise. See [`Grouping`].
+    /// (DVXplorer), `block` (the vote over every event of the bin) otherwise. See
+    /// [`Grouping`].
     Auto,
 }
 
@@ -102,7 +103,7 @@ impl Grouping {
             (SamplingMethod::Paper, format!("scan groups: {measured}"))
         } else {
             (
-                SamplingMethod::Sum,
+                SamplingMethod::Block,
                 format!("events stamped one by one: {measured}"),
             )
         }
@@ -474,7 +475,7 @@ mod tests {
     }
 
     #[test]
-    fn auto_samples_scan_groups_as_the_paper_and_single_stamps_as_a_sum() {
+    fn auto_samples_scan_groups_as_the_paper_and_single_stamps_as_a_vote_over_the_bin() {
         let stream = |groups: usize, per: usize, step: i64| {
             let mut b = EventBatch::default();
             for g in 0..groups {
@@ -508,9 +509,9 @@ mod tests {
         }
         let g = Grouping::measure(&b.t);
         assert!((0.1..0.25).contains(&g.short_share), "{g:?}");
-        assert_eq!(pick(&b), SamplingMethod::Sum);
+        assert_eq!(pick(&b), SamplingMethod::Block);
         // a busy Prophesee sensor: ten events in every µs
-        assert_eq!(pick(&stream(20_000, 10, 1)), SamplingMethod::Sum);
+        assert_eq!(pick(&stream(20_000, 10, 1)), SamplingMethod::Block);
         // the paper's sampler on such a stream would vote with one timestamp's few events
         let g = Grouping::measure(&stream(20_000, 10, 1).t);
         assert!(!g.is_scanned() && (g.events_per_timestamp - 10.0).abs() < 1e-9);

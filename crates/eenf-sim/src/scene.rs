@@ -28,16 +28,20 @@ pub enum SceneKind {
     ExtremeDim,
     /// A high-dynamic-range view: a daylit window and a bare bulb, saturating parts of it.
     ExtremeBright,
+    /// A daylit room where the mains light reaches only a lamp's pool (~5 % of the view)
+    /// while a person walks by: the flicker lives in a few pixels, as in real recordings.
+    LampSpot,
 }
 
 impl SceneKind {
     /// Every kind, in the order of their names.
-    pub const ALL: [SceneKind; 5] = [
+    pub const ALL: [SceneKind; 6] = [
         SceneKind::Static,
         SceneKind::DynamicObject,
         SceneKind::DynamicCamera,
         SceneKind::ExtremeDim,
         SceneKind::ExtremeBright,
+        SceneKind::LampSpot,
     ];
 
     /// The kind's name on the command line.
@@ -48,6 +52,7 @@ impl SceneKind {
             SceneKind::DynamicCamera => "dynamic-camera",
             SceneKind::ExtremeDim => "extreme-dim",
             SceneKind::ExtremeBright => "extreme-bright",
+            SceneKind::LampSpot => "lamp-spot",
         }
     }
 

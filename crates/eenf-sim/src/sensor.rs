@@ -226,6 +226,15 @@ impl SimConfig {
                         gain: 60.0,
                     });
                 }
+                SceneKind::LampSpot => {
+                    // daylight everywhere; the lamp's light counts only in its pool
+                    self.ambient = 0.995;
+                    self.scene.bulb = Some(Region {
+                        rect: (0.12, 0.58, 0.34, 0.81),
+                        gain: 150.0,
+                    });
+                    self.scene.objects.push(walker());
+                }
             }
         }
         self.kinds = kinds.to_vec();

@@ -15,8 +15,11 @@ use crate::progress::Progress;
 pub struct CameraFlicker {
     /// The camera, in a file with several.
     pub camera: Option<u8>,
-    /// Its strongest line near 100/120 Hz (`None`: shorter than a second, or no events).
+    /// Its strongest line near 100/120 Hz in the signal E-ENF samples (`auto` sampling;
+    /// `None`: shorter than a second, or no events).
     pub line: Option<FlickerLine>,
+    /// The same in the 1 ms ON − OFF sums (the measure real recordings are calibrated with).
+    pub sum_line: Option<FlickerLine>,
 }
 
 /// A recording read to the end.
@@ -41,6 +44,7 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
     let info = reader.info().clone();
     let mut stats = StreamStats::default();
     let mut sampler = TemporalSampler::new(SamplingMethod::Sum, 1000);
+    let mut auto = TemporalSampler::new(SamplingMethod::Auto, 1000);
     let mut grouping = None;
     let mut wild = false;
     while let Some(b) = reader.next_batch()? {
@@ -49,7 +53,7 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
             grouping = Some(Grouping::measure(&b.t));
         }
         // a wild timestamp ends the flicker analysis, not the statistics
-        wild = wild || sampler.push(&b).is_err();
+        wild = wild || sampler.push(&b).is_err() || auto.push(&b).is_err();
     }
     let skipped = reader.skipped();
     let line_of = |sampler: TemporalSampler| {
@@ -65,18 +69,23 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
                 camera: Some(c),
                 ..open.clone()
             };
-            let s = sample_with(path, &one, SamplingMethod::Sum, 1000, &Progress::hidden())?;
-            let x: Vec<f64> = s.seq.values.iter().map(|&v| v as f64).collect();
+            let line = |method| -> Result<Option<FlickerLine>> {
+                let s = sample_with(path, &one, method, 1000, &Progress::hidden())?;
+                let x: Vec<f64> = s.seq.values.iter().map(|&v| v as f64).collect();
+                Ok(flicker_line(&x, s.seq.fs()))
+            };
             out.push(CameraFlicker {
                 camera: Some(c),
-                line: flicker_line(&x, s.seq.fs()),
+                line: line(SamplingMethod::Auto)?,
+                sum_line: line(SamplingMethod::Sum)?,
             });
         }
         out
     } else {
         vec![CameraFlicker {
             camera: open.camera,
-            line: if wild { None } else { line_of(sampler) },
+            line: if wild { None } else { line_of(auto) },
+            sum_line: if wild { None } else { line_of(sampler) },
         }]
     };
     Ok(Inspection {

@@ -267,7 +267,7 @@ fn a_camera_clock_that_runs_off_is_recognised_and_reported_as_measured() {
     let (ok, out, err) = eenf(&["extract", "edvs.txt"], d);
     assert!(ok, "{err}");
     assert!(err.contains("60 Hz grid"), "{err}");
-    assert!(err.contains("sum sampling"), "{err}");
+    assert!(err.contains("block sampling"), "{err}");
     assert!(err.contains("0.26 % below 120 Hz"), "{err}");
     let v: Vec<f64> = out
         .lines()

@@ -236,3 +236,41 @@ fn bad_simulation_options_are_refused_clearly() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
 }
+
+/// A daylit room where only a lamp's pool flickers and a person walks by, seen by a sensor that
+/// stamps every event on its own (~7 k events/s): traced with the defaults against the truth.
+#[test]
+fn a_lamp_spot_seen_event_by_event_is_traced_with_the_defaults() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    for seed in ["1", "3"] {
+        ok(
+            &[
+                "-q",
+                "simulate",
+                "--scene",
+                "lamp-spot",
+                "--readout",
+                "prophesee",
+                "--resolution",
+                "48x48",
+                "--duration",
+                "30",
+                "--seed",
+                seed,
+                "-o",
+                "spot.aedat4",
+            ],
+            d,
+        );
+        let x = json(&ok(
+            &["-q", "extract", "spot.aedat4", "--json", "-o", "spot.csv"],
+            d,
+        ));
+        assert_eq!(x["sampling"], "block", "{seed}");
+        assert_eq!(x["nominal_hz"], 50.0, "{seed}");
+        let c = json(&ok(&["compare", "spot.csv", "spot.truth.csv", "--json"], d));
+        let (cc, mae) = (c["cc"].as_f64().unwrap(), c["mae_hz"].as_f64().unwrap());
+        assert!(cc >= 0.9 && mae <= 0.002, "seed {seed}: CC {cc}, MAE {mae}");
+    }
+}

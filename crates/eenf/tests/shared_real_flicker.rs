@@ -61,8 +61,8 @@ fn real_dvs128_recordings_are_traced_with_the_defaults() {
             (got - want).abs() <= 0.010,
             "{name} {camera:?}: {got} vs {want}"
         );
-        // per-event timestamps: every event counts
-        assert_eq!(v["sampling"], "sum", "{name}");
+        // per-event timestamps: every event of a bin votes
+        assert_eq!(v["sampling"], "block", "{name}");
         assert!(v["enf_hz"].as_array().unwrap().len() >= 30);
     }
     // the stereo pair without --camera: one camera, never a mix of both clocks
@@ -82,12 +82,16 @@ fn info_reports_the_chip_the_cameras_and_each_flicker_line() {
         out.contains("chip inferred from the addresses as DVS128"),
         "{out}"
     );
-    assert!(out.contains("camera 0: 100.028 Hz (50 Hz grid)"), "{out}");
-    assert!(out.contains("camera 1: 99.937 Hz (50 Hz grid)"), "{out}");
+    // the lines E-ENF samples, and in the ON − OFF sums of the independent analysis
+    assert!(out.contains("camera 0: 100.03"), "{out}");
+    assert!(out.contains("ON − OFF sums: 100.028 Hz"), "{out}");
+    assert!(out.contains("camera 1: 99.94"), "{out}");
+    assert!(out.contains("ON − OFF sums: 99.937 Hz"), "{out}");
     let f = real("jaer_MovingDarkBox.aedat");
     let out = cli::ok(&["info", f.to_str().unwrap(), "--json"], dir.path());
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let line = &v["flicker"][0]["line"];
+    assert!((v["flicker"][0]["line"]["hz"].as_f64().unwrap() - 99.980).abs() < 0.003);
+    let line = &v["flicker"][0]["sum_line"];
     // the independent analysis: 99.980 Hz, prominence 19.8
     assert!(
         (line["hz"].as_f64().unwrap() - 99.980).abs() < 0.002,

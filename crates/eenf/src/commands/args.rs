@@ -48,7 +48,7 @@ pub struct MethodArgs {
     #[command(flatten)]
     pub tracker: TrackerArgs,
     /// Temporal sampling: auto (paper when events come in scan groups that share a timestamp,
-    /// as a DVXplorer's; sum when each event has its own, as DVS128, DAVIS and Prophesee
+    /// as a DVXplorer's; block when each event has its own, as DVS128, DAVIS and Prophesee
     /// sensors stamp them), paper (events at the smallest timestamp ≥ t_n), authors (the group
     /// at the largest timestamp in [t_n, t_n + Δt), previous sample when empty), block (vote
     /// over all events in [t_n, t_n + Δt), the journal version), sum (ON − OFF count of all
@@ -73,11 +73,15 @@ pub struct MethodArgs {
     /// Harmonic-selection segment length, in estimates.
     #[arg(long, default_value_t = 10)]
     pub segment: usize,
-    /// Harmonic-selection rule: smoothest (the paper: the smoothest harmonic trace per
-    /// segment) or consensus (the smoothest among harmonics that agree with another one,
-    /// within --agree-hz).
-    #[arg(long, default_value = "consensus", value_parser = one_of::<HarmonicSelection>(&HarmonicSelection::NAMES))]
+    /// Harmonic-selection rule: journal (follow the 2f0 band; where it jumps by more than
+    /// --jump-hz or is missing, take the harmonic that continues the trace best), smoothest (the
+    /// paper: the smoothest harmonic trace per segment), consensus (the smoothest among
+    /// harmonics that agree with another one, within --agree-hz).
+    #[arg(long, default_value = "journal", value_parser = one_of::<HarmonicSelection>(&HarmonicSelection::NAMES))]
     pub selection: HarmonicSelection,
+    /// Largest step of the journal rule's 2f0 trace between estimates, Hz (on the ENF scale).
+    #[arg(long, default_value_t = HarmonicSelection::DEFAULT_JUMP_HZ)]
+    pub jump_hz: f64,
     /// Agreement tolerance of the consensus rule, Hz (on the ENF scale).
     #[arg(long, default_value_t = HarmonicSelection::DEFAULT_AGREE_HZ)]
     pub agree_hz: f64,
@@ -135,6 +139,7 @@ impl MethodArgs {
         params.segment_len = self.segment.max(1);
         params.selection = match self.selection {
             HarmonicSelection::Consensus(_) => HarmonicSelection::Consensus(self.agree_hz),
+            HarmonicSelection::Journal(_) => HarmonicSelection::Journal(self.jump_hz),
             other => other,
         };
         Ok(ExtractOptions {
@@ -276,8 +281,8 @@ pub fn parse_scene(s: &str) -> Result<Vec<SceneKind>> {
         .map(|k| {
             SceneKind::parse(k).with_context(|| {
                 format!(
-                    "--scene {k:?}: expected static, dynamic-object, dynamic-camera, extreme-dim \
-                     or extreme-bright"
+                    "--scene {k:?}: expected static, dynamic-object, dynamic-camera, extreme-dim, \
+                     extreme-bright or lamp-spot"
                 )
             })
         })

@@ -17,7 +17,8 @@ use super::args::{
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
     /// Scene classes, comma-separated (mixes allowed): static, dynamic-object,
-    /// dynamic-camera, extreme-dim, extreme-bright.
+    /// dynamic-camera, extreme-dim, extreme-bright, lamp-spot (a daylit room where only a
+    /// lamp's pool, ~5 % of the view, flickers, and a person walks by).
     #[arg(long, default_value = "static")]
     pub scene: String,
     /// Lamps, comma-separated (at most 3), each KIND[@PHASE_DEG][*SHARE] with KIND one of
@@ -59,6 +60,10 @@ pub struct Args {
     /// Share of non-flickering light (daylight), 0..1.
     #[arg(long)]
     pub ambient: Option<f64>,
+    /// How much brighter the first lamp is inside its pool (`lamp-spot`) or bulb
+    /// (`extreme-bright`) than elsewhere: sets how strongly those pixels flicker.
+    #[arg(long)]
+    pub spot_gain: Option<f64>,
     /// Local start time of the recording (names, timestamps; a WAV or CSV source named with
     /// its time sets it).
     #[arg(long, default_value = eenf::simulation::DEFAULT_START)]
@@ -95,6 +100,15 @@ fn config(a: &Args) -> Result<SimConfig> {
     }
     if let Some(x) = a.ambient {
         config.ambient = x;
+    }
+    if let Some(g) = a.spot_gain {
+        match config.scene.bulb.as_mut() {
+            Some(b) if g > 0.0 => b.gain = g,
+            Some(_) => bail!("--spot-gain must be positive"),
+            None => {
+                bail!("--spot-gain needs a scene with a lamp in view (lamp-spot, extreme-bright)")
+            }
+        }
     }
     config.check().map_err(|e| anyhow::anyhow!("{e}"))?;
     Ok(config)
