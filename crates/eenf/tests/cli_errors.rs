@@ -277,3 +277,37 @@ fn a_camera_clock_that_runs_off_is_recognised_and_reported_as_measured() {
     let mean = v.iter().sum::<f64>() / v.len() as f64;
     assert!((mean - 119.69 / 2.0).abs() < 0.002, "{mean}");
 }
+
+#[test]
+fn a_recording_without_flicker_names_the_strongest_line_and_its_height() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    // daylight only: nothing flickers, the walker still makes events
+    let (ok, _, err) = eenf(
+        &[
+            "-q",
+            "simulate",
+            "--scene",
+            "dynamic-object",
+            "--ambient",
+            "0.9999",
+            "--duration",
+            "20",
+            "--resolution",
+            "24x18",
+            "-o",
+            "dark.aedat4",
+        ],
+        d,
+    );
+    assert!(ok, "{err}");
+    let (ok, _, err) = eenf(&["extract", "dark.aedat4"], d);
+    assert!(!ok);
+    assert!(err.contains("dark.aedat4"), "{err}");
+    assert!(
+        err.contains("no mains flicker: the strongest line near 100 or 120 Hz"),
+        "{err}"
+    );
+    assert!(err.contains("above the noise (6x needed)"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+}
