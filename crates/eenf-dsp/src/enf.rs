@@ -52,7 +52,7 @@ impl Default for EnfParams {
             median_len: 21,
             median_threshold_hz: 0.02,
             segment_len: 10,
-            selection: HarmonicSelection::Journal(HarmonicSelection::DEFAULT_JUMP_HZ),
+            selection: HarmonicSelection::Consensus(HarmonicSelection::DEFAULT_AGREE_HZ),
         }
     }
 }

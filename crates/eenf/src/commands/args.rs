@@ -73,11 +73,12 @@ pub struct MethodArgs {
     /// Harmonic-selection segment length, in estimates.
     #[arg(long, default_value_t = 10)]
     pub segment: usize,
-    /// Harmonic-selection rule: journal (follow the 2f0 band; where it jumps by more than
-    /// --jump-hz or is missing, take the harmonic that continues the trace best), smoothest (the
-    /// paper: the smoothest harmonic trace per segment), consensus (the smoothest among
-    /// harmonics that agree with another one, within --agree-hz).
-    #[arg(long, default_value = "journal", value_parser = one_of::<HarmonicSelection>(&HarmonicSelection::NAMES))]
+    /// Harmonic-selection rule: consensus (the smoothest among harmonics that agree with
+    /// another one, within --agree-hz), smoothest (the paper: the smoothest harmonic trace per
+    /// segment), journal (follow the 2f0 band; where it jumps by more than --jump-hz or is
+    /// missing, take the harmonic that continues the trace best). A band whose line stands less
+    /// than 12 dB above its noise is not taken where another's does.
+    #[arg(long, default_value = "consensus", value_parser = one_of::<HarmonicSelection>(&HarmonicSelection::NAMES))]
     pub selection: HarmonicSelection,
     /// Largest step of the journal rule's 2f0 trace between estimates, Hz (on the ENF scale).
     #[arg(long, default_value_t = HarmonicSelection::DEFAULT_JUMP_HZ)]
