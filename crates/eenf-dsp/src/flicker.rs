@@ -144,26 +144,29 @@ pub fn flicker_lines(x: &[f64], fs: f64) -> Option<[FlickerLine; 2]> {
 mod tests {
     use super::*;
 
+    /// Close to Gaussian noise of unit variance (a sum of twelve uniforms), from `seed`.
+    fn noise(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            (0..12)
+                .map(|_| {
+                    seed ^= seed << 13;
+                    seed ^= seed >> 7;
+                    seed ^= seed << 17;
+                    (seed >> 11) as f64 / (1u64 << 53) as f64
+                })
+                .sum::<f64>()
+                - 6.0
+        }
+    }
+
     /// A tone in noise: the line is found to a few mHz and its prominence grows with its
     /// amplitude; noise alone stays below the threshold.
     #[test]
     fn finds_a_line_in_noise_and_none_in_noise_alone() {
         let fs = 1000.0;
         let n = 40_000;
-        let mut s = 0x1234_5678_9abc_def0u64;
-        let mut noise = || {
-            // sum of uniforms: close to Gaussian, unit variance
-            (0..12)
-                .map(|_| {
-                    s ^= s << 13;
-                    s ^= s >> 7;
-                    s ^= s << 17;
-                    (s >> 11) as f64 / (1u64 << 53) as f64
-                })
-                .sum::<f64>()
-                - 6.0
-        };
-        let noise: Vec<f64> = (0..n).map(|_| noise()).collect();
+        let mut draw = noise(0x1234_5678_9abc_def0);
+        let noise: Vec<f64> = (0..n).map(|_| draw()).collect();
         let alone = flicker_line(&noise, fs).unwrap();
         assert!(alone.prominence < MIN_FLICKER_PROMINENCE, "{alone:?}");
         let tone = |a: f64, f: f64| -> Vec<f64> {
@@ -190,20 +193,9 @@ mod tests {
     #[test]
     fn line_strength_is_read_where_the_line_is_and_about_one_elsewhere() {
         let fs = 500.0;
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut noise = || {
-            (0..12)
-                .map(|_| {
-                    seed ^= seed << 13;
-                    seed ^= seed >> 7;
-                    seed ^= seed << 17;
-                    (seed >> 11) as f64 / (1u64 << 53) as f64
-                })
-                .sum::<f64>()
-                - 6.0
-        };
+        let mut draw = noise(0x2545_f491_4f6c_dd1d);
         let x: Vec<f64> = (0..20_000)
-            .map(|i| noise() + 0.3 * (2.0 * std::f64::consts::PI * 100.02 * i as f64 / fs).sin())
+            .map(|i| draw() + 0.3 * (2.0 * std::f64::consts::PI * 100.02 * i as f64 / fs).sin())
             .collect();
         let at = line_strength_at(&x, fs, 100.02).unwrap();
         let off = line_strength_at(&x, fs, 117.3).unwrap();

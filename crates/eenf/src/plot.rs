@@ -328,31 +328,7 @@ fn spectrogram_chart<DB: DrawingBackend>(
             .map_err(e)?;
     }
     // colour bar
-    let mut b = ChartBuilder::on(&bar_area)
-        .margin(12)
-        .margin_left(4)
-        .x_label_area_size(40)
-        .y_label_area_size(55)
-        .build_cartesian_2d(0.0..1.0, floor_db..0.0)
-        .map_err(e)?;
-    b.configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_label_style(("sans-serif", 14))
-        .axis_desc_style(("sans-serif", 15))
-        .y_desc("power (dB)")
-        .draw()
-        .map_err(e)?;
-    let steps = 64;
-    b.draw_series((0..steps).map(|k| {
-        let lo = floor_db * (1.0 - k as f64 / steps as f64);
-        let hi = floor_db * (1.0 - (k + 1) as f64 / steps as f64);
-        Rectangle::new(
-            [(0.0, lo), (1.0, hi)],
-            heat(k as f64 / steps as f64).filled(),
-        )
-    }))
-    .map_err(e)?;
+    colour_bar(&bar_area, (floor_db, 0.0), "power (dB)")?;
     Ok(())
 }
 
@@ -637,6 +613,39 @@ pub fn plot_extraction(path: &Path, title: &str, trace: &Trace) -> Result<()> {
     )
 }
 
+/// A vertical colour bar of [`heat`] over `range` (low to high), labelled `what`.
+fn colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    range: (f64, f64),
+    what: &str,
+) -> Result<()> {
+    let mut b = ChartBuilder::on(area)
+        .margin(12)
+        .margin_left(4)
+        .x_label_area_size(40)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..1.0, range.0..range.1)
+        .map_err(e)?;
+    b.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .y_desc(what)
+        .draw()
+        .map_err(e)?;
+    let steps = 64;
+    let at = |k: usize| range.0 + (range.1 - range.0) * k as f64 / steps as f64;
+    b.draw_series((0..steps).map(|k| {
+        Rectangle::new(
+            [(0.0, at(k)), (1.0, at(k + 1))],
+            heat(k as f64 / steps as f64).filled(),
+        )
+    }))
+    .map_err(e)?;
+    Ok(())
+}
+
 fn flicker_map_chart<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
@@ -691,31 +700,7 @@ fn flicker_map_chart<DB: DrawingBackend>(
         )
     }))
     .map_err(e)?;
-    let mut b = ChartBuilder::on(&bar_area)
-        .margin(12)
-        .margin_left(4)
-        .x_label_area_size(40)
-        .y_label_area_size(55)
-        .build_cartesian_2d(0.0..1.0, 0.0..top_db)
-        .map_err(e)?;
-    b.configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_label_style(("sans-serif", 14))
-        .axis_desc_style(("sans-serif", 15))
-        .y_desc("line over noise (dB)")
-        .draw()
-        .map_err(e)?;
-    let steps = 64;
-    b.draw_series((0..steps).map(|k| {
-        let lo = top_db * k as f64 / steps as f64;
-        let hi = top_db * (k + 1) as f64 / steps as f64;
-        Rectangle::new(
-            [(0.0, lo), (1.0, hi)],
-            heat(k as f64 / steps as f64).filled(),
-        )
-    }))
-    .map_err(e)?;
+    colour_bar(&bar_area, (0.0, top_db), "line over noise (dB)")?;
     Ok(())
 }
 
