@@ -4,8 +4,8 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use eenf_dsp::{
-    check_line, detect_nominal, extract_enf, flicker_line, flicker_lines, EnfParams, FlickerLine,
-    PolaritySequence, SamplingMethod, TemporalSampler, MIN_FLICKER_PROMINENCE,
+    check_line, detect_nominal, enf_from_flicker, flicker_line, flicker_lines, EnfParams,
+    FlickerLine, PolaritySequence, SamplingMethod, TemporalSampler, MIN_FLICKER_PROMINENCE,
 };
 use eenf_events::{OpenOptions, StreamInfo};
 
@@ -245,7 +245,8 @@ pub fn extract_sampled(
     params.nominal_hz = f0;
     notes.extend(note);
     let spin = progress.spinner("tracking the ENF");
-    let estimates = extract_enf(seq, &params).map_err(err)?;
+    // the signal already converted above is tracked as it is (no second copy)
+    let estimates = enf_from_flicker(&x, fs, &params).map_err(err)?;
     spin.finish_and_clear();
     let provenance = EventsProvenance {
         format: s.info.format.to_string(),
