@@ -132,8 +132,7 @@ pub struct EnfEstimates {
 
 /// E-ENF from a polarity sequence (the output of the temporal sampler).
 pub fn extract_enf(seq: &PolaritySequence, p: &EnfParams) -> Result<EnfEstimates, DspError> {
-    let x: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
-    enf_from_flicker(&x, seq.fs(), p)
+    enf_from_flicker(&seq.signal(), seq.fs(), p)
 }
 
 /// The ENF from any signal that flickers at 2·f_e and its harmonics, sampled at `fs`.

@@ -146,6 +146,11 @@ impl PolaritySequence {
         1e6 / self.dt_us as f64
     }
 
+    /// The values as the filters and trackers take them.
+    pub fn signal(&self) -> Vec<f64> {
+        self.values.iter().map(|&v| v as f64).collect()
+    }
+
     /// Duration covered, in seconds.
     pub fn duration_s(&self) -> f64 {
         self.values.len() as f64 * self.dt_us as f64 * 1e-6

@@ -87,7 +87,18 @@ pub fn sample_with(
     dt_us: i64,
     progress: &Progress,
 ) -> Result<Sampled> {
-    let mut reader = eenf_events::open_with(path, open)?;
+    let reader = eenf_events::open_with(path, open)?;
+    sample_reader(reader, path, sampling, dt_us, progress)
+}
+
+/// Reads an opened recording (`path` names it) to its end into a flicker signal.
+fn sample_reader(
+    mut reader: Box<dyn eenf_events::EventReader>,
+    path: &Path,
+    sampling: SamplingMethod,
+    dt_us: i64,
+    progress: &Progress,
+) -> Result<Sampled> {
     let info = reader.info().clone();
     let bar = progress.events(info.event_count, "reading events");
     let mut sampler = TemporalSampler::new(sampling, dt_us);
@@ -114,27 +125,34 @@ pub fn sample_with(
     })
 }
 
+/// The flicker line of one camera of `path`, in its 1 ms signal sampled with `method`.
+pub fn camera_line(
+    path: &Path,
+    open: &OpenOptions,
+    camera: u8,
+    method: SamplingMethod,
+) -> Result<Option<FlickerLine>> {
+    let one = OpenOptions {
+        camera: Some(camera),
+        ..open.clone()
+    };
+    let s = sample_with(path, &one, method, 1000, &Progress::hidden())?;
+    Ok(flicker_line(&s.seq.signal(), s.seq.fs()))
+}
+
 /// Reads an event file into its flicker signal. A file with several cameras (a stereo pair,
 /// whose cameras run on two clocks) is read for the camera `opts.open` names, else for the one
 /// whose flicker line stands higher: never a mix of both.
 pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> Result<Sampled> {
-    let cameras = eenf_events::open_with(path, &opts.open)?
-        .info()
-        .cameras
-        .len();
+    let reader = eenf_events::open_with(path, &opts.open)?;
+    let cameras = reader.info().cameras.len();
     if cameras < 2 || opts.open.camera.is_some() {
-        return sample_with(path, &opts.open, opts.sampling, opts.dt_us, progress);
+        return sample_reader(reader, path, opts.sampling, opts.dt_us, progress);
     }
     let mut best: Option<(u8, f64)> = None;
     let mut heard = Vec::new();
     for c in 0..cameras.min(u8::MAX as usize) as u8 {
-        let open = OpenOptions {
-            camera: Some(c),
-            ..opts.open.clone()
-        };
-        let s = sample_with(path, &open, SamplingMethod::Sum, 1000, &Progress::hidden())?;
-        let x: Vec<f64> = s.seq.values.iter().map(|&v| v as f64).collect();
-        let line = flicker_line(&x, s.seq.fs());
+        let line = camera_line(path, &opts.open, c, SamplingMethod::Sum)?;
         let prominence = line.map_or(0.0, |l| l.prominence);
         heard.push(match line {
             Some(l) => format!("camera {c}: {:.3} Hz, {:.1}x", l.hz, l.prominence),
@@ -218,7 +236,7 @@ pub fn extract_sampled(
     progress: &Progress,
 ) -> Result<Trace> {
     let seq = &s.seq;
-    let x: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
+    let x = seq.signal();
     let fs = seq.fs();
     let mut params = opts.params.clone();
     let mut notes = s.notes;

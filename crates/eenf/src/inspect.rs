@@ -7,8 +7,7 @@ use anyhow::Result;
 use eenf_dsp::{flicker_line, FlickerLine, Grouping, SamplingMethod, TemporalSampler};
 use eenf_events::{OpenOptions, StreamInfo, StreamStats};
 
-use crate::extract::sample_with;
-use crate::progress::Progress;
+use crate::extract::camera_line;
 
 /// The flicker of one camera.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -58,26 +57,16 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
     let skipped = reader.skipped();
     let line_of = |sampler: TemporalSampler| {
         let seq = sampler.finish().ok()?;
-        let x: Vec<f64> = seq.values.iter().map(|&v| v as f64).collect();
-        flicker_line(&x, seq.fs())
+        flicker_line(&seq.signal(), seq.fs())
     };
     let flicker = if info.cameras.len() > 1 && open.camera.is_none() {
         // two clocks: each camera on its own
         let mut out = Vec::new();
         for c in 0..info.cameras.len().min(u8::MAX as usize) as u8 {
-            let one = OpenOptions {
-                camera: Some(c),
-                ..open.clone()
-            };
-            let line = |method| -> Result<Option<FlickerLine>> {
-                let s = sample_with(path, &one, method, 1000, &Progress::hidden())?;
-                let x: Vec<f64> = s.seq.values.iter().map(|&v| v as f64).collect();
-                Ok(flicker_line(&x, s.seq.fs()))
-            };
             out.push(CameraFlicker {
                 camera: Some(c),
-                line: line(SamplingMethod::Auto)?,
-                sum_line: line(SamplingMethod::Sum)?,
+                line: camera_line(path, open, c, SamplingMethod::Auto)?,
+                sum_line: camera_line(path, open, c, SamplingMethod::Sum)?,
             });
         }
         out
