@@ -106,6 +106,41 @@ pub fn butter_bandpass(order: usize, low: f64, high: f64, fs: f64) -> Vec<Sectio
     zpk2sos_nearest(&mut zeros, zpoles, k)
 }
 
+/// Second-order sections of a low-pass Butterworth filter of even `order` with cutoff `cutoff`
+/// Hz (−3 dB) at sampling rate `fs`: scipy's `butter(order, cutoff, fs=fs, output="sos")`.
+///
+/// Panics if `order` is odd or zero, or the cutoff is not inside (0, fs/2).
+pub fn butter_lowpass(order: usize, cutoff: f64, fs: f64) -> Vec<Section> {
+    assert!(
+        order > 0 && order.is_multiple_of(2),
+        "order {order} must be even"
+    );
+    assert!(
+        0.0 < cutoff && cutoff < fs / 2.0,
+        "cutoff {cutoff} Hz must lie inside (0, {} Hz)",
+        fs / 2.0
+    );
+    let n = order as i64;
+    let fs_int = 2.0;
+    let wc = 2.0 * fs_int * (PI * (2.0 * cutoff / fs) / fs_int).tan();
+    // analog prototype (buttap), scaled to the warped cutoff (lp2lp_zpk)
+    let poles: Vec<C> = (0..n)
+        .map(|i| {
+            let a = PI * (-n + 1 + 2 * i) as f64 / (2.0 * n as f64);
+            C::new(-a.cos(), -a.sin()).scale(wc)
+        })
+        .collect();
+    // bilinear_zpk: no finite zeros; the `order` zeros at infinity map to z = -1
+    let fs2 = C::new(2.0 * fs_int, 0.0);
+    let den = poles
+        .iter()
+        .fold(C::new(1.0, 0.0), |d, p| d.mul(fs2.sub(*p)));
+    let k = wc.powi(order as i32) * C::new(1.0, 0.0).div(den).re;
+    let zpoles: Vec<C> = poles.iter().map(|p| fs2.add(*p).div(fs2.sub(*p))).collect();
+    let mut zeros = vec![-1.0; order];
+    zpk2sos_nearest(&mut zeros, zpoles, k)
+}
+
 /// scipy's zpk2sos with pairing "nearest", for real zeros and complex-conjugate poles (the
 /// band-pass case): sections are filled from the last, each taking the remaining pole closest to
 /// the unit circle and the two real zeros nearest to it; the gain goes into the first section.

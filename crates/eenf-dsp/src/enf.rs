@@ -217,15 +217,39 @@ pub const MIN_BAND_SNR_DB: f64 = 12.0;
 /// above its noise there?
 fn audibility(harmonics: &[HarmonicEstimates], segment: usize) -> Vec<Vec<bool>> {
     let segment = segment.max(1);
-    harmonics
+    // each band's mean line strength per segment
+    let means: Vec<Vec<f64>> = harmonics
         .iter()
         .map(|h| {
             h.snr_db
                 .chunks(segment)
                 .map(|c| {
                     let v: Vec<f64> = c.iter().copied().filter(|s| s.is_finite()).collect();
-                    !v.is_empty() && v.iter().sum::<f64>() / v.len() as f64 >= MIN_BAND_SNR_DB
+                    if v.is_empty() {
+                        f64::NEG_INFINITY
+                    } else {
+                        v.iter().sum::<f64>() / v.len() as f64
+                    }
                 })
+                .collect()
+        })
+        .collect();
+    let segments = means.iter().map(Vec::len).max().unwrap_or(0);
+    let best: Vec<f64> = (0..segments)
+        .map(|k| {
+            means
+                .iter()
+                .filter_map(|m| m.get(k).copied())
+                .fold(f64::NEG_INFINITY, f64::max)
+        })
+        .collect();
+    means
+        .iter()
+        .map(|m| {
+            m.iter()
+                .zip(&best)
+                // where no band clears the bar, the strongest stands for it
+                .map(|(&v, &b)| v >= MIN_BAND_SNR_DB || (v.is_finite() && v >= b))
                 .collect()
         })
         .collect()
@@ -324,4 +348,36 @@ pub fn check_line(x: &[f64], fs: f64, nominal: f64, multiple: f64) -> Result<(),
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn band(harmonic: usize, snr_db: &[f64]) -> HarmonicEstimates {
+        HarmonicEstimates {
+            harmonic,
+            center_hz: 100.0 * harmonic as f64,
+            enf_hz: vec![50.0; snr_db.len()],
+            snr_db: snr_db.to_vec(),
+        }
+    }
+
+    #[test]
+    fn bands_above_the_bar_are_heard_and_else_only_the_strongest() {
+        // segment 0: bands 1 and 2 clear 12 dB; segment 1: none does, band 3 is strongest
+        let h = [
+            band(1, &[20.0, 14.0, 9.0, 10.0]),
+            band(2, &[13.0, 12.0, 8.0, 8.0]),
+            band(3, &[5.0, 6.0, 10.0, 11.0]),
+        ];
+        let a = audibility(&h, 2);
+        assert_eq!(
+            a,
+            vec![vec![true, false], vec![true, false], vec![false, true]]
+        );
+        // a band with no finite estimate in a segment is never heard
+        let h = [band(1, &[f64::NAN, f64::NAN]), band(2, &[3.0, 4.0])];
+        assert_eq!(audibility(&h, 2), vec![vec![false], vec![true]]);
+    }
 }

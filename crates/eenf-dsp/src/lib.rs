@@ -20,6 +20,7 @@
 #![forbid(unsafe_code)]
 
 pub mod butter;
+pub mod decimate;
 pub mod enf;
 pub mod filtfilt;
 pub mod flicker;
@@ -30,7 +31,8 @@ pub mod sampling;
 pub mod spectrogram;
 pub mod tracker;
 
-pub use butter::{butter_bandpass, sos_to_ba, Section};
+pub use butter::{butter_bandpass, butter_lowpass, sos_to_ba, Section};
+pub use decimate::{decimate, decimation_for};
 pub use enf::{
     check_line, detect_nominal, enf_from_flicker, extract_enf, line_prominence, reference_enf,
     DspError, EnfEstimates, EnfParams, HarmonicEstimates,

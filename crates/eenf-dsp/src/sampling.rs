@@ -25,6 +25,17 @@ pub enum SamplingMethod {
 }
 
 impl SamplingMethod {
+    /// The sampling interval that suits the method, µs: the paper's 1 ms for the samplers of
+    /// scan groups; 100 µs for the vote and sum over per-event stamps, whose bins see every
+    /// event, so that the flicker's harmonics up to 5 kHz do not alias onto the bands (at
+    /// 1 ms the 6th, 8th, … harmonics of a 100 Hz flicker fold onto the 4th, 2nd, …).
+    pub fn default_dt_us(self) -> i64 {
+        match self {
+            SamplingMethod::Block | SamplingMethod::Sum => 100,
+            _ => 1000,
+        }
+    }
+
     /// Every variant, by its command-line name.
     pub const NAMES: [&'static str; 5] = ["paper", "authors", "block", "sum", "auto"];
     const ALL: [SamplingMethod; 5] = [
@@ -185,6 +196,8 @@ pub struct TemporalSampler {
     group: Option<(i64, usize, i64)>,
     max_samples: usize,
     events: u64,
+    /// The interval follows the method (`auto` decides both at the first events).
+    auto_dt: bool,
 }
 
 fn sign(v: i64) -> i8 {
@@ -192,10 +205,29 @@ fn sign(v: i64) -> i8 {
 }
 
 impl TemporalSampler {
+    /// A sampler with interval `dt_us`, or the method's own
+    /// ([`SamplingMethod::default_dt_us`]) when `None`.
+    pub fn with_interval(method: SamplingMethod, dt_us: Option<i64>) -> Self {
+        let mut s = Self::new(method, dt_us.unwrap_or(method.default_dt_us()));
+        s.auto_dt = dt_us.is_none();
+        s
+    }
+
+    fn set_interval(&mut self, dt_us: i64) {
+        self.dt = dt_us;
+        self.max_samples = (48 * 3600 * 1_000_000 / dt_us) as usize;
+    }
+
+    /// The sampling interval, µs (with `auto`, decided at the first events).
+    pub fn dt_us(&self) -> i64 {
+        self.dt
+    }
+
     /// A sampler with interval `dt_us` (1000 for the paper's 1 ms).
     pub fn new(method: SamplingMethod, dt_us: i64) -> Self {
         assert!(dt_us > 0, "sampling interval must be positive");
         TemporalSampler {
+            auto_dt: false,
             method,
             dt: dt_us,
             t0: None,
@@ -241,6 +273,9 @@ impl TemporalSampler {
             let (method, reason) = Grouping::measure(&batch.t).choice();
             self.method = method;
             self.reason = Some(reason);
+            if self.auto_dt {
+                self.set_interval(method.default_dt_us());
+            }
         }
         match self.method {
             SamplingMethod::Paper => self.push_paper(batch, t0),

@@ -33,5 +33,7 @@ mod sensor;
 pub use camera::{render_video, CameraConfig, VideoStats};
 pub use lamp::{Lamp, LampBank, LampKind};
 pub use mains::{phase_from_start, MainsError, MainsPhase, SyntheticEnf};
-pub use scene::{MovingObject, Region, Scene, SceneConfig, SceneKind, Shake, CHANNELS, MAX_LAMPS};
+pub use scene::{
+    person, walker, MovingObject, Region, Scene, SceneConfig, SceneKind, Shake, CHANNELS, MAX_LAMPS,
+};
 pub use sensor::{simulate, PixelConfig, Readout, SimConfig, SimStats};

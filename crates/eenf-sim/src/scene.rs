@@ -86,6 +86,11 @@ pub enum MovingObject {
         specular: f64,
         /// Time at which it enters, s.
         phase_s: f64,
+        /// How irregular the gait is: the walking speed and the step rate vary by up to
+        /// 1.6× this share, slowly (0: a machine's constant pace, whose pixel crossings and
+        /// steps repeat so exactly that they make spectral lines near 100–120 Hz).
+        #[serde(default)]
+        gait: f64,
     },
     /// A fan turning in the view: bright blades over a dark hub and the background.
     Fan {
@@ -152,8 +157,18 @@ impl SceneConfig {
     }
 }
 
-/// The default walker of `dynamic-object` scenes.
+/// The default walker of `dynamic-object` scenes: a constant pace.
 pub fn walker() -> MovingObject {
+    walker_with_gait(0.0)
+}
+
+/// A person's walk (`lamp-spot` scenes): [`walker`] with an irregular pace, speed and step
+/// rate varying by up to ±40 %.
+pub fn person() -> MovingObject {
+    walker_with_gait(0.25)
+}
+
+fn walker_with_gait(gait: f64) -> MovingObject {
     MovingObject::Walker {
         speed: 0.25,
         width: 0.14,
@@ -163,6 +178,7 @@ pub fn walker() -> MovingObject {
         shadow_offset: (0.05, 0.03),
         specular: 2.0,
         phase_s: 0.0,
+        gait,
     }
 }
 
@@ -431,13 +447,18 @@ impl Scene {
     }
 
     /// Where the walker is at `t`: body centre x (fraction) and bob (fraction).
-    fn walker_pos(speed: f64, width: f64, phase_s: f64, t: f64) -> (f64, f64) {
+    fn walker_pos(speed: f64, width: f64, phase_s: f64, gait: f64, t: f64) -> (f64, f64) {
+        // an irregular pace: time warped by slow, incommensurate swings (a pure function
+        // of t, so the motion interpolation can ask for any instant)
+        let swing = |f: f64, phase: f64| (2.0 * PI * f * t + phase).sin() / (2.0 * PI * f);
+        let walk_t = t + gait * (swing(0.11, 0.0) + 0.6 * swing(0.23, 1.3));
+        let step_t = t + gait * swing(0.17, 0.4);
         // to and fro across the view, entering from outside it
         let span = 1.0 + 2.0 * width;
         let period = 2.0 * span / speed.max(1e-6);
-        let s = ((t + phase_s) / period).fract() * 2.0 * span;
+        let s = ((walk_t + phase_s) / period).rem_euclid(1.0) * 2.0 * span;
         let x = if s < span { s } else { 2.0 * span - s } - width;
-        (x, 0.015 * (2.0 * PI * 1.8 * t).sin())
+        (x, 0.015 * (2.0 * PI * 1.8 * step_t).sin())
     }
 
     /// Pixel boxes `(x0, y0, x1, y1)` (half-open) that the objects, their shadows and
@@ -468,12 +489,13 @@ impl Scene {
                     y,
                     shadow_offset,
                     phase_s,
+                    gait,
                     ..
                 } => {
-                    let (xa, _) = Self::walker_pos(speed, width, phase_s, t0);
-                    let (xb, _) = Self::walker_pos(speed, width, phase_s, t1);
+                    let (xa, _) = Self::walker_pos(speed, width, phase_s, gait, t0);
+                    let (xb, _) = Self::walker_pos(speed, width, phase_s, gait, t1);
                     // a turn between t0 and t1 stays within the step's travel of both ends
-                    let travel = speed * (t1 - t0);
+                    let travel = speed * (1.0 + 1.6 * gait.abs()) * (t1 - t0);
                     let left = xa.min(xb) - width / 2.0 - travel - 0.01;
                     let right = xa.max(xb) + width / 2.0 + travel + shadow_offset.0.max(0.0) + 0.01;
                     let top = y - height / 2.0 - 0.7 * width * w / h - 0.03;
@@ -507,9 +529,10 @@ impl Scene {
                         speed,
                         width,
                         phase_s,
+                        gait,
                         ..
                     } => {
-                        let (x, bob) = Self::walker_pos(speed, width, phase_s, t);
+                        let (x, bob) = Self::walker_pos(speed, width, phase_s, gait, t);
                         (*o, x, bob)
                     }
                     MovingObject::Fan { rev_per_s, .. } => (*o, 2.0 * PI * rev_per_s * t, 0.0),

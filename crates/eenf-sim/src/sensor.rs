@@ -1,6 +1,7 @@
 //! The event sensor: photoreceptors with an illumination-dependent bandwidth, log compression,
 //! per-pixel contrast thresholds, refractory period, shot noise, leak and hot pixels, and a
-//! readout (DVXplorer-like scans with a finite bandwidth, or Prophesee-like µs timestamps).
+//! readout (DVXplorer-like scans with a finite bandwidth, Prophesee-like µs timestamps, or a
+//! DVS128-like arbiter that serves one event at a time).
 //!
 //! Pixels are simulated in fixed chunks of rows, in parallel; each chunk has its own random
 //! stream, so the same seed gives the same recording on any number of threads.
@@ -13,7 +14,7 @@ use rayon::prelude::*;
 use crate::lamp::{Lamp, LampBank, LampKind};
 use crate::mains::MainsPhase;
 use crate::scene::{
-    fan, walker, Region, Scene, SceneConfig, SceneKind, Shake, CHANNELS, MAX_LAMPS,
+    fan, person, walker, Region, Scene, SceneConfig, SceneKind, Shake, CHANNELS, MAX_LAMPS,
 };
 
 /// Time steps simulated together (one output batch).
@@ -97,6 +98,15 @@ pub enum Readout {
         /// Event-rate controller limit, million events per second.
         max_rate_mev_s: f64,
     },
+    /// DVS128-like (jAER): an AER arbiter serves the pixels one event at a time, each
+    /// stamped with its own µs time when served, so no two events share a timestamp and a
+    /// burst leaves spread out at the bus rate (Lichtsteiner et al. 2008: ~1 M events/s).
+    Dvs128 {
+        /// Simulation step, µs.
+        step_us: i64,
+        /// Bus rate, million events per second (one event per 1/rate µs).
+        max_rate_mev_s: f64,
+    },
 }
 
 impl Readout {
@@ -118,26 +128,37 @@ impl Readout {
         }
     }
 
-    /// `dvxplorer` or `prophesee` with defaults.
+    /// The DVS128 default: 50 µs steps, a 1 M events/s arbiter.
+    pub fn dvs128() -> Self {
+        Readout::Dvs128 {
+            step_us: 50,
+            max_rate_mev_s: 1.0,
+        }
+    }
+
+    /// `dvxplorer`, `prophesee` or `dvs128` with defaults.
     pub fn named(name: &str) -> Option<Self> {
         match name {
             "dvxplorer" => Some(Self::dvxplorer()),
             "prophesee" => Some(Self::prophesee()),
+            "dvs128" => Some(Self::dvs128()),
             _ => None,
         }
     }
 
-    fn step_us(&self) -> i64 {
+    /// The simulation step (DVXplorer: the scan period), µs.
+    pub fn step_us(&self) -> i64 {
         match *self {
             Readout::Dvxplorer { scan_period_us, .. } => scan_period_us.max(1),
-            Readout::Prophesee { step_us, .. } => step_us.max(1),
+            Readout::Prophesee { step_us, .. } | Readout::Dvs128 { step_us, .. } => step_us.max(1),
         }
     }
 
     fn max_rate(&self) -> f64 {
         match *self {
             Readout::Dvxplorer { max_rate_mev_s, .. }
-            | Readout::Prophesee { max_rate_mev_s, .. } => max_rate_mev_s * 1e6,
+            | Readout::Prophesee { max_rate_mev_s, .. }
+            | Readout::Dvs128 { max_rate_mev_s, .. } => max_rate_mev_s * 1e6,
         }
     }
 }
@@ -227,13 +248,14 @@ impl SimConfig {
                     });
                 }
                 SceneKind::LampSpot => {
-                    // daylight everywhere; the lamp's light counts only in its pool
-                    self.ambient = 0.995;
+                    // daylight everywhere; the lamp's light counts only in its pool, where it
+                    // is about as bright as the daylight (elsewhere 10⁻⁴ of the light)
+                    self.ambient = 0.9999;
                     self.scene.bulb = Some(Region {
                         rect: (0.12, 0.58, 0.34, 0.81),
-                        gain: 150.0,
+                        gain: 20_000.0,
                     });
-                    self.scene.objects.push(walker());
+                    self.scene.objects.push(person());
                 }
             }
         }
@@ -881,7 +903,7 @@ fn generate(
         shot_hz: px.shot_noise_hz as f32,
         shot_max_hz: px.shot_noise_max_hz as f32,
         motion_step_s: config.motion_step_us.max(step_us) as f64 * 1e-6,
-        prophesee: matches!(config.readout, Readout::Prophesee { .. }),
+        prophesee: !matches!(config.readout, Readout::Dvxplorer { .. }),
         one_lamp: shares.len() == 1,
     };
     let mut bank = LampBank::new(&config.lamps[..shares.len()], mains);
@@ -972,10 +994,15 @@ fn generate(
             fifo_events,
             ..
         } => (scan_jitter_us.clamp(0, step_us / 2 - 1).max(0), fifo_events),
-        Readout::Prophesee { .. } => (0, 0),
+        Readout::Prophesee { .. } | Readout::Dvs128 { .. } => (0, 0),
     };
     let per_step_cap = ((config.readout.max_rate() * step_s).floor() as usize).max(1);
-    let prophesee = matches!(config.readout, Readout::Prophesee { .. });
+    // own timestamps (Prophesee, DVS128) rather than the scan's
+    let prophesee = !matches!(config.readout, Readout::Dvxplorer { .. });
+    // DVS128: the arbiter serves one event per `service_us`; the time it is next free
+    let arbiter = matches!(config.readout, Readout::Dvs128 { .. });
+    let service_us = (1e6 / config.readout.max_rate()).ceil().max(1.0) as i64;
+    let mut bus_free = i64::MIN;
 
     let mut stats = SimStats::default();
     let mut batch = EventBatch::default();
@@ -1029,7 +1056,17 @@ fn generate(
                     step_events.push((o.offset_us[k], o.x[k], o.y[k], o.on[k]));
                 }
             }
-            if prophesee {
+            if arbiter {
+                step_events.sort_by_key(|e| e.0);
+                for &(off, x, y, on) in &step_events {
+                    // served when the crossing happened, or when the bus is next free
+                    let t = (t_abs - step_us + off as i64)
+                        .max(config.start_us)
+                        .max(bus_free);
+                    bus_free = t + service_us;
+                    batch.push(t, x, y, on);
+                }
+            } else if prophesee {
                 step_events.sort_by_key(|e| e.0);
                 if step_events.len() > per_step_cap {
                     stats.dropped_events += (step_events.len() - per_step_cap) as u64;

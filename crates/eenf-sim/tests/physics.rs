@@ -375,6 +375,89 @@ fn the_dvxplorer_readout_groups_events_in_scans_and_has_a_finite_bandwidth() {
 }
 
 #[test]
+fn the_dvs128_arbiter_serves_one_event_at_a_time_at_its_bus_rate() {
+    let seconds = 0.5;
+    let mains = steady_50hz(seconds + 1.0);
+    let fluorescent = vec![Lamp {
+        kind: LampKind::named("fluorescent").unwrap(),
+        phase_deg: 0.0,
+        share: 1.0,
+    }];
+    let scene = SimConfig {
+        width: 64,
+        height: 48,
+        duration_s: seconds,
+        lamps: fluorescent,
+        readout: Readout::prophesee(),
+        ..SimConfig::default()
+    };
+    let p = run(&scene, &mains);
+    let d = run(
+        &SimConfig {
+            readout: Readout::dvs128(),
+            ..scene.clone()
+        },
+        &mains,
+    );
+    // the same pixels fire; the arbiter drops nothing, it only spreads bursts out
+    assert_eq!(d.t.len(), p.t.len());
+    assert_eq!(d.stats.dropped_events, 0);
+    // no two events share a timestamp: each is at least one bus cycle (1 µs) after the last
+    assert!(d.t.windows(2).all(|w| w[1] > w[0]));
+    let mut shared = p.t.clone();
+    shared.dedup();
+    assert!(shared.len() < p.t.len(), "the Prophesee readout shares µs");
+    // a slower bus delays the flicker's bursts further: 0.1 M events/s is 10 µs an event
+    let slow = run(
+        &SimConfig {
+            readout: Readout::Dvs128 {
+                step_us: 50,
+                max_rate_mev_s: 0.1,
+            },
+            ..scene
+        },
+        &mains,
+    );
+    assert!(slow.t.windows(2).all(|w| w[1] - w[0] >= 10));
+}
+
+#[test]
+fn a_person_walking_makes_no_spectral_line_near_the_flicker() {
+    // a constant pace repeats its pixel crossings so exactly that they make lines near
+    // 100–120 Hz; a person's irregular pace must not (nothing here flickers)
+    let seconds = 20.0;
+    let mains = steady_50hz(seconds + 1.0);
+    let mut config = SimConfig {
+        width: 32,
+        height: 32,
+        duration_s: seconds,
+        lamps: sinusoid_lamp(0.0),
+        readout: Readout::prophesee(),
+        ..SimConfig::default()
+    }
+    .with_kinds(&[SceneKind::LampSpot]);
+    let e = run(&config, &mains);
+    assert!(e.t.len() > 20_000, "{} events", e.t.len());
+    let x = net_counts(&e, 1000, seconds);
+    let strongest = |x: &[f64]| {
+        (0..=600)
+            .map(|k| line(x, 90.0 + 0.05 * k as f64, 1000.0))
+            .fold(0.0f64, f64::max)
+    };
+    let floor = (0..200)
+        .map(|k| line(&x, 140.0 + 0.3 * k as f64, 1000.0))
+        .sum::<f64>()
+        / 200.0;
+    let walk = strongest(&x);
+    assert!(walk < 6.0 * floor, "a line {:.1}x the floor", walk / floor);
+    // the machine's constant pace does make one
+    config.scene.objects = vec![eenf_sim::walker()];
+    let m = net_counts(&run(&config, &mains), 1000, seconds);
+    let machine = strongest(&m);
+    assert!(machine > 6.0 * floor, "{:.1}x the floor", machine / floor);
+}
+
+#[test]
 fn the_same_seed_gives_the_same_recording_on_any_number_of_threads() {
     let seconds = 1.0;
     let mains = steady_50hz(seconds + 1.0);

@@ -103,7 +103,8 @@ pub struct PlannedRecording {
 /// What a simulated dataset is made of.
 #[derive(Debug, Clone)]
 pub struct DatasetSpec {
-    /// `ev-enfd` (51 recordings of 180 s) or `small` (9 of 120 s).
+    /// `ev-enfd` (51 recordings of 180 s), `small` (9 of 120 s) or `lamp-spot` (80 of 40 s:
+    /// eight cameras, ten recordings each, where the flicker lives in a lamp's pool).
     pub preset: String,
     /// Recording length, s (default: the preset's).
     pub duration_s: Option<f64>,
@@ -157,6 +158,82 @@ fn random_lamps(rng: &mut rand::rngs::StdRng) -> Vec<Lamp> {
         .collect()
 }
 
+/// One camera of the `lamp-spot` preset: its class folder, readout and sensor side, and the
+/// range of the lamp's gain in its pool (log-uniform), set so that the flicker line's
+/// prominence spreads over about 6–60, the real recordings' 10–20 among them.
+struct LampSpotClass {
+    name: &'static str,
+    readout: fn() -> Readout,
+    side: u16,
+    gain: (f64, f64),
+}
+
+/// Whether a preset's manifest scores each recording against its simulated truth (`lamp-spot`:
+/// short recordings, where the hourly references' own tracking error would dominate) rather
+/// than the hourly mains references, as the EV-ENFD does.
+pub fn scored_against_truth(preset: &str) -> bool {
+    preset == "lamp-spot"
+}
+
+/// Recordings per camera of the `lamp-spot` preset.
+const LAMP_SPOT_SEEDS: usize = 10;
+
+/// The cameras of the `lamp-spot` preset: DVS128-like and Prophesee readouts (each event its
+/// own µs timestamp) at 16×16 to 128×128. A smaller sensor has fewer pixels in the pool, so it
+/// needs a brighter pool for the same prominence.
+const LAMP_SPOT_CLASSES: [LampSpotClass; 8] = {
+    const fn c(
+        name: &'static str,
+        readout: fn() -> Readout,
+        side: u16,
+        gain: (f64, f64),
+    ) -> LampSpotClass {
+        LampSpotClass {
+            name,
+            readout,
+            side,
+            gain,
+        }
+    }
+    [
+        c("dvs128-16", Readout::dvs128, 16, (11e3, 19e3)),
+        c("dvs128-32", Readout::dvs128, 32, (10e3, 17e3)),
+        c("dvs128-64", Readout::dvs128, 64, (8e3, 13e3)),
+        c("dvs128-128", Readout::dvs128, 128, (8e3, 12e3)),
+        c("prophesee-16", Readout::prophesee, 16, (11e3, 19e3)),
+        c("prophesee-32", Readout::prophesee, 32, (10e3, 17e3)),
+        c("prophesee-64", Readout::prophesee, 64, (8e3, 13e3)),
+        c("prophesee-128", Readout::prophesee, 128, (8e3, 12e3)),
+    ]
+};
+
+/// Makes `config` a camera of the `lamp-spot` preset: a room lit by daylight where only the
+/// lamp's pool (5 % of the view) flickers enough to fire pixels, a person walking by, and a
+/// DVS128's background activity (0.3 events/s per pixel).
+fn lamp_spot_camera(config: &mut SimConfig, class: &LampSpotClass, r: &mut rand::rngs::StdRng) {
+    config.width = class.side;
+    config.height = class.side;
+    config.readout = (class.readout)();
+    let (lo, hi): (f64, f64) = class.gain;
+    let gain = (lo.ln() + r.gen::<f64>() * (hi / lo).ln()).exp();
+    if let Some(b) = config.scene.bulb.as_mut() {
+        b.gain = gain;
+    }
+    config.pixel.shot_noise_hz = 0.3;
+    config.pixel.shot_noise_max_hz = 5.0;
+    // one LED lamp and one threshold: the gain alone sets how strongly the pool flickers
+    config.pixel.threshold = 0.2;
+    config.lamps = vec![Lamp {
+        kind: LampKind::Led {
+            depth: r.gen_range(0.4..0.6),
+            sharpness: 1.0,
+            smoothing_ms: r.gen_range(0.1..0.6),
+        },
+        phase_deg: 0.0,
+        share: 1.0,
+    }];
+}
+
 /// Recordings of a preset: (class, scene kinds) each.
 type Classes = Vec<(&'static str, Vec<SceneKind>)>;
 
@@ -177,7 +254,14 @@ fn preset(name: &str) -> Result<(Classes, f64, (u16, u16))> {
     let (n, duration) = match name {
         "ev-enfd" => ([16, 25, 10], 180.0),
         "small" => ([3, 3, 3], 120.0),
-        other => bail!("--preset {other:?}: expected ev-enfd or small"),
+        "lamp-spot" => {
+            let plans = LAMP_SPOT_CLASSES
+                .iter()
+                .flat_map(|c| cycle(c.name, LAMP_SPOT_SEEDS, &[&[LampSpot]]))
+                .collect();
+            return Ok((plans, 40.0, (64, 64)));
+        }
+        other => bail!("--preset {other:?}: expected ev-enfd, small or lamp-spot"),
     };
     let mut plans = cycle("static", n[0], &[&[Static]]);
     plans.extend(cycle("dynamic", n[1], dynamic));
@@ -237,6 +321,9 @@ pub fn plan_dataset(
             .with_kinds(&kinds);
             // a little variety in the sensor's bias settings
             config.pixel.threshold = r.gen_range(0.17..0.25);
+            if let Some(c) = LAMP_SPOT_CLASSES.iter().find(|c| c.name == class) {
+                lamp_spot_camera(&mut config, c, &mut r);
+            }
             if kinds.contains(&SceneKind::ExtremeDim) {
                 // night scenes from ~1 to ~6 lux on a white wall
                 config.illumination = r.gen_range(0.004..0.02);
@@ -262,6 +349,33 @@ pub fn relative(base: &Path, path: &Path) -> String {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_lamp_spot_preset_has_ten_recordings_per_camera() {
+        let spec = DatasetSpec {
+            preset: "lamp-spot".into(),
+            duration_s: None,
+            resolution: None,
+            readout: Readout::dvxplorer(),
+            tz_s: 0.0,
+            seed: 7,
+        };
+        let (plans, duration) = plan_dataset(&spec, (0.0, 6.0 * 3600.0)).unwrap();
+        assert_eq!((plans.len(), duration), (80, 40.0));
+        for c in &LAMP_SPOT_CLASSES {
+            let of: Vec<_> = plans.iter().filter(|p| p.class == c.name).collect();
+            assert_eq!(of.len(), LAMP_SPOT_SEEDS, "{}", c.name);
+            for p in of {
+                let cfg = &p.config;
+                assert_eq!((cfg.width, cfg.height), (c.side, c.side));
+                assert_eq!(cfg.readout, (c.readout)());
+                assert_eq!(cfg.kinds, vec![SceneKind::LampSpot]);
+                let gain = cfg.scene.bulb.as_ref().unwrap().gain;
+                assert!((c.gain.0..=c.gain.1).contains(&gain), "{gain}");
+            }
+        }
+        assert!(scored_against_truth("lamp-spot") && !scored_against_truth("small"));
+    }
+
     use super::*;
 
     #[test]

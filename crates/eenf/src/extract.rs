@@ -4,11 +4,13 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use eenf_dsp::{
-    check_line, detect_nominal, enf_from_flicker, flicker_line, flicker_lines, EnfParams,
-    FlickerLine, PolaritySequence, SamplingMethod, TemporalSampler, MIN_FLICKER_PROMINENCE,
+    check_line, decimate, decimation_for, detect_nominal, enf_from_flicker, flicker_line,
+    flicker_lines, EnfParams, FlickerLine, Grouping, PolaritySequence, SamplingMethod,
+    TemporalSampler, MIN_FLICKER_PROMINENCE,
 };
 use eenf_events::{OpenOptions, StreamInfo};
 
+use crate::flicker_map::{flicker_map, TileMask};
 use crate::progress::Progress;
 use crate::trace::{EventsProvenance, Trace};
 
@@ -38,8 +40,9 @@ impl std::str::FromStr for Nominal {
 pub struct ExtractOptions {
     /// Temporal sampling (`Auto` chooses from the stream).
     pub sampling: SamplingMethod,
-    /// Sampling interval, µs.
-    pub dt_us: i64,
+    /// Sampling interval, µs (`None`: the sampling's own, see
+    /// [`SamplingMethod::default_dt_us`]).
+    pub dt_us: Option<i64>,
     /// Grid frequency.
     pub nominal: Nominal,
     /// Everything after sampling (`nominal_hz` is set from `nominal`).
@@ -47,16 +50,20 @@ pub struct ExtractOptions {
     /// How to read the file: the chip of an old jAER file, the camera of a stereo pair (by
     /// default the one whose flicker is stronger).
     pub open: OpenOptions,
+    /// Trace only the tiles of pixels that flicker (see [`crate::flicker_map`]) when events
+    /// are stamped one by one; scan-grouped streams (DVXplorer) are always read whole.
+    pub flicker_tiles: bool,
 }
 
 impl Default for ExtractOptions {
     fn default() -> Self {
         ExtractOptions {
             sampling: SamplingMethod::Auto,
-            dt_us: 1000,
+            dt_us: None,
             nominal: Nominal::Auto,
             params: EnfParams::default(),
             open: OpenOptions::default(),
+            flicker_tiles: true,
         }
     }
 }
@@ -88,7 +95,7 @@ pub fn sample_with(
     progress: &Progress,
 ) -> Result<Sampled> {
     let reader = eenf_events::open_with(path, open)?;
-    sample_reader(reader, path, sampling, dt_us, progress)
+    sample_reader(reader, path, sampling, Some(dt_us), None, progress)
 }
 
 /// Reads an opened recording (`path` names it) to its end into a flicker signal.
@@ -96,28 +103,40 @@ fn sample_reader(
     mut reader: Box<dyn eenf_events::EventReader>,
     path: &Path,
     sampling: SamplingMethod,
-    dt_us: i64,
+    dt_us: Option<i64>,
+    mask: Option<&TileMask>,
     progress: &Progress,
 ) -> Result<Sampled> {
     let info = reader.info().clone();
     let bar = progress.events(info.event_count, "reading events");
-    let mut sampler = TemporalSampler::new(sampling, dt_us);
+    let mut sampler = TemporalSampler::with_interval(sampling, dt_us);
+    let mut kept = eenf_events::EventBatch::default();
+    let mut events = 0u64;
     while let Some(batch) = reader.next_batch()? {
+        events += batch.len() as u64;
+        let batch = match mask {
+            Some(m) => {
+                m.filter(&batch, &mut kept);
+                &kept
+            }
+            None => &batch,
+        };
         sampler
-            .push(&batch)
+            .push(batch)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         bar.inc(batch.len() as u64);
     }
     bar.finish_and_clear();
-    let events = sampler.events();
     if events == 0 {
         bail!("{}: the event stream is empty", path.display());
     }
     let seq = sampler
         .finish()
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let mut notes = info.notes.clone();
+    notes.extend(mask.map(TileMask::describe));
     Ok(Sampled {
-        notes: info.notes.clone(),
+        notes,
         camera: info.camera,
         info,
         events,
@@ -140,6 +159,16 @@ pub fn camera_line(
     Ok(flicker_line(&s.seq.signal(), s.seq.fs()))
 }
 
+/// The flicker line of `path` at the grid `grid_hz` (50 or 60 Hz), measured as the issue of
+/// real recordings calibrates scenes: the whole recording's 1 ms ON − OFF sums, Hann window,
+/// the peak near 2·grid over the median magnitude in 80–140 Hz. `None` when the recording is
+/// too short to measure.
+pub fn grid_line(path: &Path, open: &OpenOptions, grid_hz: f64) -> Result<Option<FlickerLine>> {
+    let s = sample_with(path, open, SamplingMethod::Sum, 1000, &Progress::hidden())?;
+    let lines = flicker_lines(&s.seq.signal(), s.seq.fs());
+    Ok(lines.map(|[a, b]| if grid_hz == 60.0 { b } else { a }))
+}
+
 /// Reads an event file into its flicker signal. A file with several cameras (a stereo pair,
 /// whose cameras run on two clocks) is read for the camera `opts.open` names, else for the one
 /// whose flicker line stands higher: never a mix of both.
@@ -147,7 +176,19 @@ pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> R
     let reader = eenf_events::open_with(path, &opts.open)?;
     let cameras = reader.info().cameras.len();
     if cameras < 2 || opts.open.camera.is_some() {
-        return sample_reader(reader, path, opts.sampling, opts.dt_us, progress);
+        let mask = tile_mask(path, &opts.open, opts, progress)?;
+        let reader = match mask {
+            Some(_) => eenf_events::open_with(path, &opts.open)?,
+            None => reader,
+        };
+        return sample_reader(
+            reader,
+            path,
+            opts.sampling,
+            opts.dt_us,
+            mask.as_ref(),
+            progress,
+        );
     }
     let mut best: Option<(u8, f64)> = None;
     let mut heard = Vec::new();
@@ -167,12 +208,52 @@ pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> R
         camera: Some(camera),
         ..opts.open.clone()
     };
-    let mut s = sample_with(path, &open, opts.sampling, opts.dt_us, progress)?;
+    let mask = tile_mask(path, &open, opts, progress)?;
+    let reader = eenf_events::open_with(path, &open)?;
+    let mut s = sample_reader(
+        reader,
+        path,
+        opts.sampling,
+        opts.dt_us,
+        mask.as_ref(),
+        progress,
+    )?;
     s.notes.push(format!(
         "{cameras} cameras: camera {camera} traced, its flicker stands highest ({}); --camera picks another",
         heard.join("; ")
     ));
     Ok(s)
+}
+
+/// The tiles to trace, when `opts` asks for them and the stream stamps its events one by one
+/// (a DVXplorer's scans are sampled whole, as the paper does, and are left alone).
+fn tile_mask(
+    path: &Path,
+    open: &OpenOptions,
+    opts: &ExtractOptions,
+    progress: &Progress,
+) -> Result<Option<TileMask>> {
+    if !opts.flicker_tiles
+        || !matches!(
+            opts.sampling,
+            SamplingMethod::Auto | SamplingMethod::Block | SamplingMethod::Sum
+        )
+    {
+        return Ok(None);
+    }
+    let mut reader = eenf_events::open_with(path, open)?;
+    if reader.info().width.is_none() {
+        return Ok(None);
+    }
+    let Some(first) = reader.next_batch()? else {
+        return Ok(None);
+    };
+    if opts.sampling == SamplingMethod::Auto && Grouping::measure(&first.t).is_scanned() {
+        return Ok(None);
+    }
+    drop(reader);
+    let map = flicker_map(path, open, None, progress)?;
+    Ok(TileMask::from_map(&map))
 }
 
 /// E-ENF from an event file.
@@ -236,9 +317,23 @@ pub fn extract_sampled(
     progress: &Progress,
 ) -> Result<Trace> {
     let seq = &s.seq;
-    let x = seq.signal();
-    let fs = seq.fs();
     let mut params = opts.params.clone();
+    // a finely sampled signal is brought down to the rate its bands need, without letting
+    // the flicker's higher harmonics fold onto them
+    let grid = match opts.nominal {
+        Nominal::Hz(f) => f,
+        Nominal::Auto => 60.0,
+    };
+    let top = 2.0 * grid * params.harmonics.max(1) as f64 + params.half_band_hz;
+    let (factor, cutoff) = decimation_for(seq.fs(), top);
+    let (x, fs) = if factor > 1 {
+        (
+            decimate(&seq.signal(), seq.fs(), factor, cutoff),
+            seq.fs() / factor as f64,
+        )
+    } else {
+        (seq.signal(), seq.fs())
+    };
     let mut notes = s.notes;
     let err = |e: eenf_dsp::DspError| anyhow::anyhow!("{}: {e}", path.display());
     let duration = seq.duration_s();
@@ -274,7 +369,7 @@ pub fn extract_sampled(
         duration_s: duration,
         sampling: seq.method,
         sampling_reason: seq.reason.clone(),
-        dt_us: opts.dt_us,
+        dt_us: seq.dt_us,
         params,
         camera: s.camera,
         flicker: line,

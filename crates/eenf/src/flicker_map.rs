@@ -143,3 +143,74 @@ pub fn flicker_map(
         seconds: used as f64 / fs,
     })
 }
+
+/// The tiles of a [`FlickerMap`] that extraction keeps: those whose line stands out. Events
+/// elsewhere (people, moving objects, noise) only add noise to the flicker signal.
+#[derive(Debug, Clone)]
+pub struct TileMask {
+    tile: u16,
+    cols: usize,
+    rows: usize,
+    keep: Vec<bool>,
+    /// Tiles kept.
+    pub kept: usize,
+    /// Share of the mapped events in the kept tiles.
+    pub event_share: f64,
+}
+
+impl TileMask {
+    /// The flickering tiles of `map`, or `None` when none flickers or the flicker is
+    /// everywhere (nothing to leave out: every tile with events flickers).
+    pub fn from_map(map: &FlickerMap) -> Option<Self> {
+        let mut keep = vec![false; map.strength.len()];
+        for k in map.flickering() {
+            keep[k] = true;
+        }
+        let kept = keep.iter().filter(|&&k| k).count();
+        let active = (0..keep.len()).filter(|&k| map.events[k] >= 100).count();
+        if kept == 0 || kept >= active {
+            return None;
+        }
+        let total: u64 = map.events.iter().sum();
+        let inside: u64 = (0..keep.len())
+            .filter(|&k| keep[k])
+            .map(|k| map.events[k])
+            .sum();
+        Some(TileMask {
+            tile: map.tile,
+            cols: map.cols,
+            rows: map.rows,
+            keep,
+            kept,
+            event_share: inside as f64 / total.max(1) as f64,
+        })
+    }
+
+    /// Whether the event at pixel (`x`, `y`) is kept.
+    pub fn keeps(&self, x: u16, y: u16) -> bool {
+        let (c, r) = ((x / self.tile) as usize, (y / self.tile) as usize);
+        c < self.cols && r < self.rows && self.keep[r * self.cols + c]
+    }
+
+    /// Copies the events of `batch` in kept tiles into `out` (cleared first).
+    pub fn filter(&self, batch: &eenf_events::EventBatch, out: &mut eenf_events::EventBatch) {
+        out.clear();
+        for i in 0..batch.len() {
+            if self.keeps(batch.x[i], batch.y[i]) {
+                out.push(batch.t[i], batch.x[i], batch.y[i], batch.p[i]);
+            }
+        }
+    }
+
+    /// What was kept, in words.
+    pub fn describe(&self) -> String {
+        format!(
+            "flicker map: {} of {} tiles ({}x{} px) flicker; their {:.1} % of the events are traced, the rest left out",
+            self.kept,
+            self.keep.len(),
+            self.tile,
+            self.tile,
+            100.0 * self.event_share
+        )
+    }
+}

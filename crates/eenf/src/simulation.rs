@@ -312,11 +312,7 @@ pub fn write_recording(
         .check()
         .map_err(|e| anyhow::anyhow!("{}: {e}", output.display()))?;
     let started = std::time::Instant::now();
-    let step_us = match config.readout {
-        eenf_sim::Readout::Dvxplorer { scan_period_us, .. } => scan_period_us,
-        eenf_sim::Readout::Prophesee { step_us, .. } => step_us,
-    }
-    .max(1);
+    let step_us = config.readout.step_us();
     let bar = progress.steps(
         (config.duration_s * 1e6 / step_us as f64) as u64,
         "simulating",

@@ -30,7 +30,7 @@ fn a_small_dataset_is_laid_out_like_ev_enfd_and_its_references_match_the_truth()
     let mut lines = manifest.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "recording,class,reference,offset_s,videos,scene,lamps,duration_s,seed,events"
+        "recording,class,reference,offset_s,videos,scene,lamps,duration_s,seed,events,prominence"
     );
     let rows: Vec<Vec<String>> = lines
         .map(|l| l.split(',').map(str::to_string).collect())
@@ -269,6 +269,51 @@ fn a_lamp_spot_seen_event_by_event_is_traced_with_the_defaults() {
         ));
         assert_eq!(x["sampling"], "block", "{seed}");
         assert_eq!(x["nominal_hz"], 50.0, "{seed}");
+        // only the tiles that flicker were traced, and they lie in the lamp's pool
+        let notes = x["notes"].as_array().unwrap();
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.as_str().unwrap().starts_with("flicker map:")),
+            "{notes:?}"
+        );
+        let map = json(&ok(
+            &[
+                "-q",
+                "flicker-map",
+                "spot.aedat4",
+                "-o",
+                "map.png",
+                "--json",
+            ],
+            d,
+        ));
+        let (cols, tile) = (map["cols"].as_u64().unwrap(), map["tile"].as_f64().unwrap());
+        let lit: Vec<(f64, f64)> = map["strength"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.as_f64().is_some_and(|s| s >= 3.5))
+            .map(|(k, _)| {
+                let (c, r) = (k as u64 % cols, k as u64 / cols);
+                (
+                    (c as f64 + 0.5) * tile / 48.0,
+                    (r as f64 + 0.5) * tile / 48.0,
+                )
+            })
+            .collect();
+        assert!(lit.len() >= 5, "seed {seed}: {} tiles flicker", lit.len());
+        // the pool spans (0.12, 0.58)–(0.34, 0.81) of the view; a tile's centre may sit a
+        // tile outside it
+        let slack = tile / 48.0;
+        for (u, v) in &lit {
+            assert!(
+                (0.12 - slack..=0.34 + slack).contains(u)
+                    && (0.58 - slack..=0.81 + slack).contains(v),
+                "seed {seed}: a flickering tile at ({u:.2}, {v:.2}), outside the pool"
+            );
+        }
         let c = json(&ok(&["compare", "spot.csv", "spot.truth.csv", "--json"], d));
         let (cc, mae) = (c["cc"].as_f64().unwrap(), c["mae_hz"].as_f64().unwrap());
         assert!(cc >= 0.9 && mae <= 0.002, "seed {seed}: CC {cc}, MAE {mae}");

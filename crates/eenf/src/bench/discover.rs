@@ -20,6 +20,38 @@ pub struct Recording {
     pub videos: Vec<PathBuf>,
     /// Its length if the manifest says it, s (for the memory budget).
     pub duration_s: Option<f64>,
+    /// Its flicker line's prominence if the manifest says it (the calibration measure:
+    /// whole-recording 1 ms ON − OFF sums, peak near 2f0 over the 80–140 Hz median).
+    pub prominence: Option<f64>,
+}
+
+/// The prominence bands `bench --by prominence` groups recordings into.
+pub const PROMINENCE_BANDS: [(f64, &str); 4] = [
+    (0.0, "prominence <10"),
+    (10.0, "prominence 10-15"),
+    (15.0, "prominence 15-20"),
+    (20.0, "prominence >=20"),
+];
+
+/// Regroups recordings by the prominence of their flicker line (from the manifest) instead
+/// of their class. Fails when a recording has none.
+pub fn group_by_prominence(recs: &mut [Recording]) -> Result<()> {
+    for r in recs.iter_mut() {
+        let Some(p) = r.prominence else {
+            bail!(
+                "{}: the manifest gives no prominence (simulate-dataset writes one)",
+                r.path.display()
+            );
+        };
+        let band = PROMINENCE_BANDS.iter().rev().find(|b| p >= b.0);
+        r.class = band.map_or(PROMINENCE_BANDS[0].1, |b| b.1).to_string();
+    }
+    recs.sort_by(|a, b| {
+        class_rank(&a.class)
+            .cmp(&class_rank(&b.class))
+            .then(a.path.cmp(&b.path))
+    });
+    Ok(())
 }
 
 impl Recording {
@@ -80,6 +112,9 @@ pub fn discover(dataset: &Path) -> Result<Vec<Recording>> {
 /// Class folders first in the paper's order, then the others alphabetically.
 pub fn class_rank(class: &str) -> (usize, String) {
     let known = ["static", "dynamic", "extreme"];
+    if let Some(k) = PROMINENCE_BANDS.iter().position(|b| b.1 == class) {
+        return (known.len() + 1 + k, class.to_string());
+    }
     (
         known
             .iter()
@@ -140,6 +175,7 @@ fn scan_tree(dir: &Path) -> Result<Vec<Recording>> {
                 offset_s: 0.0,
                 videos,
                 duration_s: None,
+                prominence: None,
             });
         }
     }
@@ -182,6 +218,7 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Recording>> {
         );
     };
     let (off_c, vid_c, dur_c) = (col("offset_s"), col("videos"), col("duration_s"));
+    let prom_c = col("prominence");
     let mut out = Vec::new();
     for (i, row) in reader.records().enumerate() {
         let line = i + 2;
@@ -221,10 +258,51 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Recording>> {
             offset_s,
             videos,
             duration_s: field(dur_c).parse().ok(),
+            prominence: field(prom_c).parse().ok().filter(|p: &f64| p.is_finite()),
         });
     }
     if out.is_empty() {
         bail!("{}: the manifest lists no recordings", path.display());
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recordings_group_by_the_prominence_the_manifest_gives() {
+        let rec = |name: &str, p: Option<f64>| Recording {
+            path: PathBuf::from(name),
+            class: "camera".into(),
+            reference: PathBuf::from("ref.csv"),
+            offset_s: 0.0,
+            videos: vec![],
+            duration_s: None,
+            prominence: p,
+        };
+        let mut recs = vec![
+            rec("d", Some(25.0)),
+            rec("a", Some(3.0)),
+            rec("c", Some(15.0)),
+            rec("b", Some(10.0)),
+        ];
+        group_by_prominence(&mut recs).unwrap();
+        let got: Vec<(&str, &str)> = recs
+            .iter()
+            .map(|r| (r.path.to_str().unwrap(), r.class.as_str()))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("a", "prominence <10"),
+                ("b", "prominence 10-15"),
+                ("c", "prominence 15-20"),
+                ("d", "prominence >=20")
+            ]
+        );
+        let mut none = vec![rec("e", None)];
+        assert!(group_by_prominence(&mut none).is_err());
+    }
 }

@@ -11,7 +11,7 @@ pub mod settings;
 use anyhow::{bail, Result};
 use serde::Serialize;
 
-pub use discover::{class_rank, discover, Recording};
+pub use discover::{class_rank, discover, group_by_prominence, Recording, PROMINENCE_BANDS};
 pub use run::{evaluate, run_all, summarize, ClassSummary, Outcome, Run};
 pub use settings::{sweep, Settings};
 

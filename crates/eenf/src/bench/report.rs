@@ -311,9 +311,12 @@ pub fn markdown_report(
     if let Some(run) = runs.first() {
         let e = &run.settings.extract;
         s.push_str(&format!(
-            "- E-ENF: sampling `{}`, Δt {} µs, parameters `{}`\n",
+            "- E-ENF: sampling `{}`, Δt {}, parameters `{}`\n",
             e.sampling,
-            e.dt_us,
+            e.dt_us.map_or(
+                "auto (1000 µs for scan groups, 100 µs otherwise)".into(),
+                |d| format!("{d} µs")
+            ),
             serde_json::to_string(&e.params).unwrap_or_default()
         ));
         let v = &run.settings.video;

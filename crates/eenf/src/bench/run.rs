@@ -239,7 +239,7 @@ pub fn jobs_for(recs: &[Recording], settings: &[Settings], budget_mb: u64, asked
         .fold(0.0, f64::max);
     let rate = settings
         .iter()
-        .map(|s| 1e6 / s.extract.dt_us as f64)
+        .map(|s| 1e6 / s.extract.dt_us.unwrap_or(100) as f64)
         .fold(0.0, f64::max);
     let need = (longest * (rate * 48.0).max(1080.0 * 30.0 * 16.0)) / 1048576.0 + 64.0;
     ((budget_mb as f64 / need).floor() as usize).clamp(1, asked.max(1))

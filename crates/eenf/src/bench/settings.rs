@@ -48,19 +48,30 @@ impl Settings {
                 self.video.params.window_s = w;
             }
             "dt-us" => {
-                self.extract.dt_us = value
-                    .parse()
-                    .ok()
-                    .filter(|d| (10..=1_000_000).contains(d))
-                    .ok_or_else(bad)?
+                self.extract.dt_us = match value {
+                    "auto" => None,
+                    v => Some(
+                        v.parse()
+                            .ok()
+                            .filter(|d| (10..=1_000_000).contains(d))
+                            .ok_or_else(bad)?,
+                    ),
+                }
             }
             "selection" => p.selection = value.parse().map_err(|_| bad())?,
+            "tiles" => {
+                self.extract.flicker_tiles = match value {
+                    "flicker" => true,
+                    "all" => false,
+                    _ => return Err(bad()),
+                }
+            }
             "segment" => p.segment_len = value.parse().ok().filter(|s| *s >= 1).ok_or_else(bad)?,
             "median-len" => p.median_len = value.parse().map_err(|_| bad())?,
             "scene-removal" => self.video.scene_removal = value.parse().map_err(|_| bad())?,
             "video-sampling" => self.video.sampling = value.parse().map_err(|_| bad())?,
             _ => bail!(
-                "--sweep {key}: unknown setting (harmonics, sampling, peak, window, dt-us, selection, segment, median-len, scene-removal, video-sampling)"
+                "--sweep {key}: unknown setting (harmonics, sampling, peak, window, dt-us, selection, tiles, segment, median-len, scene-removal, video-sampling)"
             ),
         }
         self.label.push((key.to_string(), value.to_string()));

@@ -55,9 +55,11 @@ pub struct MethodArgs {
     /// events in [t_n, t_n + Δt)).
     #[arg(long, default_value = "auto", value_parser = one_of::<SamplingMethod>(&SamplingMethod::NAMES))]
     pub sampling: SamplingMethod,
-    /// Sampling interval Δt, µs.
-    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(i64).range(10..=1_000_000))]
-    pub dt_us: i64,
+    /// Sampling interval Δt, µs. Default: the paper's 1000 for scan groups (paper, authors),
+    /// 100 for the vote or sum over per-event stamps (block, sum), whose flicker harmonics
+    /// would alias at 1 ms.
+    #[arg(long, value_parser = clap::value_parser!(i64).range(10..=1_000_000))]
+    pub dt_us: Option<i64>,
     /// Number of flicker harmonics M (bands at 2m·f0, m = 1..M; those above Nyquist skipped).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=16))]
     pub harmonics: u32,
@@ -86,6 +88,11 @@ pub struct MethodArgs {
     /// Agreement tolerance of the consensus rule, Hz (on the ENF scale).
     #[arg(long, default_value_t = HarmonicSelection::DEFAULT_AGREE_HZ)]
     pub agree_hz: f64,
+    /// Trace every pixel. By default, when events are stamped one by one (DVS128, DAVIS,
+    /// Prophesee), only the tiles of pixels whose flicker stands out are traced (the
+    /// `flicker-map`'s), so that motion and noise elsewhere drop out.
+    #[arg(long)]
+    pub all_pixels: bool,
     #[command(flatten)]
     pub input: InputArgs,
 }
@@ -149,6 +156,7 @@ impl MethodArgs {
             nominal: self.tracker.nominal,
             params,
             open: self.input.options(),
+            flicker_tiles: !self.all_pixels,
         })
     }
 }
@@ -312,5 +320,5 @@ pub fn parse_lamps(s: &str) -> Result<Vec<Lamp>> {
 /// `--readout` → the sensor readout.
 pub fn parse_readout(s: &str) -> Result<eenf_sim::Readout> {
     eenf_sim::Readout::named(s)
-        .with_context(|| format!("--readout {s:?}: expected dvxplorer or prophesee"))
+        .with_context(|| format!("--readout {s:?}: expected dvxplorer, prophesee or dvs128"))
 }

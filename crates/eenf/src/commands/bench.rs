@@ -7,7 +7,7 @@ use eenf::bench::report::{
     json_run, markdown_report, markdown_table, write_csv, write_plots, write_traces, ReportContext,
 };
 use eenf::bench::run::{jobs_for, run_all};
-use eenf::bench::{discover, sweep, Method, Settings};
+use eenf::bench::{discover, group_by_prominence, sweep, Method, Settings};
 use eenf::extract::Nominal;
 use eenf::output::write_atomic;
 use eenf::progress::Progress;
@@ -48,13 +48,18 @@ pub struct Args {
     #[arg(long)]
     pub traces: Option<PathBuf>,
     /// Ablation: `key=v1,v2,…` (repeatable); one table per combination. Keys: harmonics,
-    /// sampling, peak, window, dt-us, selection, segment, median-len, scene-removal,
-    /// video-sampling.
+    /// sampling, peak, window, dt-us, selection, tiles (flicker or all), segment, median-len,
+    /// scene-removal, video-sampling.
     #[arg(long)]
     pub sweep: Vec<String>,
     /// V-ENF scene removal: paper, row-mean, none.
     #[arg(long, default_value = "paper", value_parser = one_of::<SceneRemoval>(&SceneRemoval::NAMES))]
     pub scene_removal: SceneRemoval,
+    /// Group the recordings by `class` (their folder or manifest class) or by `prominence`
+    /// (of their flicker line, from the manifest's `prominence` column: <10, 10-15, 15-20,
+    /// >=20).
+    #[arg(long, default_value = "class", value_parser = ["class", "prominence"])]
+    pub by: String,
     #[command(flatten)]
     pub method: MethodArgs,
 }
@@ -62,7 +67,10 @@ pub struct Args {
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let started = std::time::Instant::now();
     let methods = Method::parse_list(&a.methods)?;
-    let recs = discover(&a.dataset)?;
+    let mut recs = discover(&a.dataset)?;
+    if a.by == "prominence" {
+        group_by_prominence(&mut recs)?;
+    }
     let extract = a.method.options()?;
     let video = VideoOptions {
         nominal_hz: match a.method.tracker.nominal {

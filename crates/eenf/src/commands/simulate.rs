@@ -50,8 +50,8 @@ pub struct Args {
     /// Random seed (same seed, same recording).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Readout: dvxplorer (scans, shared timestamps, finite bandwidth) or prophesee (µs
-    /// timestamps).
+    /// Readout: dvxplorer (scans, shared timestamps, finite bandwidth), prophesee (µs
+    /// timestamps) or dvs128 (an arbiter serving one event at a time, each with its own µs).
     #[arg(long, default_value = "dvxplorer")]
     pub readout: String,
     /// Overall light level (1 = indoor room); the scene classes set their own.
@@ -64,6 +64,10 @@ pub struct Args {
     /// (`extreme-bright`) than elsewhere: sets how strongly those pixels flicker.
     #[arg(long)]
     pub spot_gain: Option<f64>,
+    /// Background activity: each pixel's noise events per second under an indoor room's
+    /// light (more in the dark), e.g. 0.5 for an old DVS128. Default: the simulator's 0.02.
+    #[arg(long)]
+    pub noise_hz: Option<f64>,
     /// Local start time of the recording (names, timestamps; a WAV or CSV source named with
     /// its time sets it).
     #[arg(long, default_value = eenf::simulation::DEFAULT_START)]
@@ -109,6 +113,13 @@ fn config(a: &Args) -> Result<SimConfig> {
                 bail!("--spot-gain needs a scene with a lamp in view (lamp-spot, extreme-bright)")
             }
         }
+    }
+    if let Some(n) = a.noise_hz {
+        if !(n >= 0.0 && n.is_finite()) {
+            bail!("--noise-hz must be zero or positive");
+        }
+        config.pixel.shot_noise_hz = n;
+        config.pixel.shot_noise_max_hz = config.pixel.shot_noise_max_hz.max(4.0 * n);
     }
     config.check().map_err(|e| anyhow::anyhow!("{e}"))?;
     Ok(config)

@@ -3,7 +3,9 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use eenf::dataset::{plan_dataset, recording_name, reference_name, relative, DatasetSpec};
+use eenf::dataset::{
+    plan_dataset, recording_name, reference_name, relative, scored_against_truth, DatasetSpec,
+};
 use eenf::output::write_atomic;
 use eenf::progress::Progress;
 use eenf::simulation::{write_recording, write_video, EnfTimeline};
@@ -45,7 +47,7 @@ pub struct Args {
     /// Length of every recording, s (default: the preset's).
     #[arg(long)]
     pub duration: Option<f64>,
-    /// Readout: dvxplorer or prophesee.
+    /// Readout: dvxplorer, prophesee or dvs128 (the `lamp-spot` preset sets its own).
     #[arg(long, default_value = "dvxplorer")]
     pub readout: String,
     /// AEDAT4 packet compression.
@@ -147,6 +149,17 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             &Progress::hidden(),
         )?;
         total_events += sim.stats.events;
+        // the flicker line's prominence: what the realistic scenes are calibrated by
+        let line = eenf::extract::grid_line(&path, &Default::default(), timeline.nominal_hz())?;
+        let prominence = line.map_or(String::new(), |l| format!("{:.2}", l.prominence));
+        let (reference, offset_s) = if scored_against_truth(&a.preset) {
+            (relative(&a.out_dir, &sim.truth), 0)
+        } else {
+            (
+                relative(&a.out_dir, &ref_dir.join(reference_name(&t))),
+                t.second_of_hour(),
+            )
+        };
         let mut videos = Vec::new();
         for camera in &cameras {
             let hidden = Progress::hidden();
@@ -167,17 +180,18 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             })
             .collect();
         rows.push(format!(
-            "{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{}",
             relative(&a.out_dir, &path),
             plan.class,
-            relative(&a.out_dir, &ref_dir.join(reference_name(&t))),
-            t.second_of_hour(),
+            reference,
+            offset_s,
             videos.join(";"),
             kinds.join("+"),
             lamps.join("+"),
             duration,
             plan.config.seed,
-            sim.stats.events
+            sim.stats.events,
+            prominence
         ));
         bar.inc(1);
     }
@@ -185,7 +199,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     write_atomic(&a.out_dir.join("manifest.csv"), |w| {
         writeln!(
             w,
-            "recording,class,reference,offset_s,videos,scene,lamps,duration_s,seed,events"
+            "recording,class,reference,offset_s,videos,scene,lamps,duration_s,seed,events,prominence"
         )?;
         for r in &rows {
             writeln!(w, "{r}")?;
