@@ -137,6 +137,19 @@ pub fn extract_enf(seq: &PolaritySequence, p: &EnfParams) -> Result<EnfEstimates
 
 /// The ENF from any signal that flickers at 2·f_e and its harmonics, sampled at `fs`.
 pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimates, DspError> {
+    enf_from_lines(x, fs, p, 2.0)
+}
+
+/// The ENF from a signal whose lines sit at `multiple`·m·f_e, m = 1..`p.harmonics`: 2 for
+/// flicker (light follows the power, twice the mains), 1 for mains hum in audio. Each band is
+/// band-passed and tracked, outliers corrected on the scale of the first line, and the bands
+/// combined by `p.selection` among those whose line stands above the noise.
+pub fn enf_from_lines(
+    x: &[f64],
+    fs: f64,
+    p: &EnfParams,
+    multiple: f64,
+) -> Result<EnfEstimates, DspError> {
     let duration_s = x.len() as f64 / fs;
     if duration_s < p.window_s {
         return Err(DspError::TooShort {
@@ -146,7 +159,7 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimate
     }
     let nyquist = fs / 2.0;
     let bands: Vec<usize> = (1..=p.harmonics)
-        .filter(|m| 2.0 * *m as f64 * p.nominal_hz + p.half_band_hz < nyquist)
+        .filter(|m| multiple * *m as f64 * p.nominal_hz + p.half_band_hz < nyquist)
         .collect();
     if bands.is_empty() {
         return Err(DspError::NoHarmonic {
@@ -158,22 +171,22 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimate
     let harmonics: Vec<HarmonicEstimates> = bands
         .par_iter()
         .map(|&m| {
-            let center = 2.0 * m as f64 * p.nominal_hz;
+            let center = multiple * m as f64 * p.nominal_hz;
             let band = (center - p.half_band_hz, center + p.half_band_hz);
             let sos = butter_bandpass(p.filter_order, band.0, band.1, fs);
             let y = sosfiltfilt(&sos, x);
             let tracked = tracker.track_with_snr(&y, band);
-            // correct outliers on the 2f0 scale, report on the f_e scale
-            let on_2f0: Vec<f64> = tracked.iter().map(|(f, _)| f / m as f64).collect();
+            // correct outliers on the first line's scale, report on the f_e scale
+            let on_first: Vec<f64> = tracked.iter().map(|(f, _)| f / m as f64).collect();
             let corrected = if p.median_len > 1 {
-                median_correct(&on_2f0, p.median_len, p.median_threshold_hz)
+                median_correct(&on_first, p.median_len, p.median_threshold_hz)
             } else {
-                on_2f0
+                on_first
             };
             HarmonicEstimates {
                 harmonic: m,
                 center_hz: center,
-                enf_hz: corrected.iter().map(|f| f / 2.0).collect(),
+                enf_hz: corrected.iter().map(|f| f / multiple).collect(),
                 snr_db: tracked.iter().map(|(_, s)| *s).collect(),
             }
         })
@@ -182,7 +195,7 @@ pub fn enf_from_flicker(x: &[f64], fs: f64, p: &EnfParams) -> Result<EnfEstimate
     let audible = audibility(&harmonics, p.segment_len);
     let (enf_hz, chosen) = select_audible_harmonics(&traces, &audible, p.segment_len, p.selection);
     if enf_hz.iter().all(|v| !v.is_finite()) {
-        return Err(DspError::NoTone("the flicker bands hold no signal".into()));
+        return Err(DspError::NoTone("the bands hold no signal".into()));
     }
     // the journal rule chooses per estimate
     let seg = match p.selection {

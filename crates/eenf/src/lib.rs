@@ -15,6 +15,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod audio;
 pub mod bench;
 pub mod dataset;
 pub mod evaluate;

@@ -33,7 +33,9 @@ enum Command {
     Extract(commands::extract::Args),
     /// Map where in the view the mains flicker is: its line's strength per tile of pixels.
     FlickerMap(commands::flicker_map::Args),
-    /// Build the reference ENF trace from a mains/audio WAV recording.
+    /// The ENF of a mains recording or of any recording's sound (WAV, FLAC, MP3, M4A, OGG, a
+    /// video's soundtrack): the mains hum, f0 and optionally its harmonics.
+    #[command(visible_alias = "audio")]
     Reference(commands::reference::Args),
     /// Compare an ENF trace with a reference: CC, MAE, RMSE, max error.
     Compare(commands::compare::Args),

@@ -5,14 +5,17 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use eenf_dsp::matching::{match_trace, MatchError, MatchOptions, MatchResult, ScaledSeries};
-use eenf_dsp::{check_line, detect_nominal, reference_enf, EnfParams};
+use eenf_dsp::{
+    check_line, detect_nominal, enf_from_lines, line_prominence, reference_enf, EnfParams,
+};
 
 use crate::dataset::hourly_references;
 use crate::extract::Nominal;
 use crate::progress::Progress;
 use crate::refdb::{RefSeries, GAP};
 use crate::time::LocalTime;
-use crate::trace::Trace;
+use crate::audio::{read_audio, AudioOptions};
+use crate::trace::{AudioProvenance, MainsProvenance, Provenance, Trace};
 use crate::wav::{read_wav, Signal};
 
 /// Decides or checks the nominal frequency of a mains signal.
@@ -41,17 +44,103 @@ pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<f64>
     })
 }
 
-/// The reference trace of a whole mains WAV.
+/// The reference trace of a whole mains WAV (every channel mixed, f0 alone: the method's
+/// reference tracker).
 pub fn reference_file(path: &Path, nominal: Nominal, params: &EnfParams) -> Result<Trace> {
-    let sig = read_wav(path)?;
-    let f0 = mains_nominal(&sig, nominal, path)?;
+    audio_trace(path, &AudioOptions::default(), 1, nominal, params)
+}
+
+/// The grid of a sound whose mains lines may sit at any of f0 … `harmonics`·f0 (a device's hum
+/// is often stronger at 2f0 or 3f0 than at f0): the grid and multiple whose line stands highest.
+fn hum_nominal(sig: &Signal, nominal: Nominal, harmonics: usize, path: &Path) -> Result<f64> {
+    let grids: &[f64] = match nominal {
+        Nominal::Auto => &[50.0, 60.0],
+        Nominal::Hz(f) => std::slice::from_ref(match f {
+            f if f == 50.0 => &50.0,
+            _ => &60.0,
+        }),
+    };
+    let mut best = (0.0, grids[0], 1.0);
+    for &f in grids {
+        for m in 1..=harmonics {
+            let p = line_prominence(&sig.samples, sig.fs, f * m as f64);
+            if p > best.0 {
+                best = (p, f, m as f64);
+            }
+        }
+    }
+    let (_, f0, m) = best;
+    check_line(&sig.samples, sig.fs, f0, m)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(f0)
+}
+
+/// The ENF of a recording's sound (a mains recording, a voice recorder, a video's soundtrack):
+/// read as `audio` says, decimated to what `harmonics` lines need, and tracked on f0 alone
+/// (`harmonics` 1: the method's reference tracker, unfiltered) or on f0 … N·f0, band by band,
+/// combined by the selection rule of `params` with each line's strength, as E-ENF does.
+pub fn audio_trace(
+    path: &Path,
+    audio: &AudioOptions,
+    harmonics: usize,
+    nominal: Nominal,
+    params: &EnfParams,
+) -> Result<Trace> {
+    let harmonics = harmonics.max(1);
+    let grid = match nominal {
+        Nominal::Hz(f) => f,
+        Nominal::Auto => 60.0,
+    };
+    let opts = AudioOptions {
+        top_hz: Some(harmonics as f64 * grid + params.half_band_hz + 4.0),
+        ..*audio
+    };
+    let a = read_audio(path, &opts)?;
+    let sig = &a.signal;
+    let provenance_audio = AudioProvenance {
+        decoder: a.decoder.to_string(),
+        source_rate_hz: a.source_rate,
+        rate_hz: sig.fs,
+        channels: a.channels,
+        channel: audio.channel.to_string(),
+        frames: a.frames,
+    };
+    if harmonics == 1 {
+        let f0 = mains_nominal(sig, nominal, path)?;
+        let p = EnfParams {
+            nominal_hz: f0,
+            ..params.clone()
+        };
+        let enf = reference_enf(&sig.samples, sig.fs, &p)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let mut t = Trace::from_mains(path, f0, &p, enf);
+        if let Some(Provenance::Mains(m)) = t.provenance.as_mut() {
+            // a plain mains WAV at its own rate keeps the bare provenance it always had
+            if a.source_rate != sig.fs || a.channels > 1 || a.decoder != "symphonia" {
+                m.audio = Some(provenance_audio);
+            }
+        }
+        return Ok(t);
+    }
+    let f0 = hum_nominal(sig, nominal, harmonics, path)?;
     let p = EnfParams {
         nominal_hz: f0,
+        harmonics,
         ..params.clone()
     };
-    let enf = reference_enf(&sig.samples, sig.fs, &p)
+    let estimates = enf_from_lines(&sig.samples, sig.fs, &p, 1.0)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    Ok(Trace::from_mains(path, f0, &p, enf))
+    Ok(Trace::from_mains_lines(
+        path,
+        f0,
+        &estimates,
+        MainsProvenance {
+            peak: p.peak,
+            window_s: p.window_s,
+            harmonics,
+            audio: Some(provenance_audio),
+        },
+    ))
 }
 
 /// The reference trace for a recording that starts at `start` (local time from its name) and

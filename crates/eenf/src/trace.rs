@@ -107,13 +107,40 @@ pub struct VideoProvenance {
     pub params: EnfParams,
 }
 
-/// How a mains recording became a reference trace.
+/// How a mains or audio recording became a trace.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MainsProvenance {
     /// Peak refinement used.
     pub peak: PeakMethod,
     /// STFT window, s.
     pub window_s: f64,
+    /// Mains lines tracked (f0 … N·f0); 1 is the method's reference tracker on f0 alone.
+    #[serde(default = "one")]
+    pub harmonics: usize,
+    /// How the sound was read, when it was (decoder, rates, channel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub audio: Option<AudioProvenance>,
+}
+
+fn one() -> usize {
+    1
+}
+
+/// How a recording's sound was read.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AudioProvenance {
+    /// `symphonia` or `ffmpeg`.
+    pub decoder: String,
+    /// The recording's own sample rate, Hz.
+    pub source_rate_hz: f64,
+    /// The rate tracked, after decimation, Hz.
+    pub rate_hz: f64,
+    /// The recording's channels.
+    pub channels: usize,
+    /// The channel traced: `mix` or its number.
+    pub channel: String,
+    /// Frames decoded.
+    pub frames: u64,
 }
 
 /// Where a trace came from and how it was made; `None` for a bare CSV.
@@ -193,10 +220,32 @@ impl Trace {
         estimates: &EnfEstimates,
         provenance: EventsProvenance,
     ) -> Self {
+        Trace {
+            nominal_hz: Some(provenance.params.nominal_hz),
+            provenance: Some(Provenance::Events(provenance)),
+            ..Trace::from_estimates(file, estimates)
+        }
+    }
+
+    /// The trace of a mains or audio recording whose lines were tracked band by band.
+    pub fn from_mains_lines(
+        file: &Path,
+        nominal_hz: f64,
+        estimates: &EnfEstimates,
+        provenance: MainsProvenance,
+    ) -> Self {
+        Trace {
+            nominal_hz: Some(nominal_hz),
+            provenance: Some(Provenance::Mains(provenance)),
+            ..Trace::from_estimates(file, estimates)
+        }
+    }
+
+    /// The values, line strengths, per-harmonic parts and selection of `estimates`.
+    fn from_estimates(file: &Path, estimates: &EnfEstimates) -> Self {
         let seg = estimates.segment_len as f64 * estimates.step_s;
         Trace {
             file: Some(file.to_path_buf()),
-            nominal_hz: Some(provenance.params.nominal_hz),
             harmonics: estimates
                 .harmonics
                 .iter()
@@ -216,7 +265,6 @@ impl Trace {
                     harmonic: m,
                 })
                 .collect(),
-            provenance: Some(Provenance::Events(provenance)),
             snr_db: estimates.snr_db.clone(),
             ..Trace::new(estimates.step_s, estimates.enf_hz.clone())
         }
@@ -253,6 +301,8 @@ impl Trace {
             provenance: Some(Provenance::Mains(MainsProvenance {
                 peak: params.peak,
                 window_s: params.window_s,
+                harmonics: 1,
+                audio: None,
             })),
             ..Trace::new(params.step_s, enf_hz)
         }

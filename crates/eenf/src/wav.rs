@@ -1,10 +1,12 @@
-//! Mains/audio recordings: WAV of any rate, integer or float samples; the first channel is used.
+//! Mains recordings as WAV: the first channel read at its own rate (through [`crate::audio`]),
+//! and 16-bit mono WAVs written.
 
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 
 /// Samples of a mono signal.
+#[derive(Debug, Clone)]
 pub struct Signal {
     /// Sampling rate, Hz.
     pub fs: f64,
@@ -12,58 +14,14 @@ pub struct Signal {
     pub samples: Vec<f64>,
 }
 
-/// Largest WAV accepted: 24 h of 48 kHz; a larger length field is taken as corrupt.
-const MAX_FRAMES: u64 = 24 * 3600 * 48_000;
-
-/// Reads a WAV file.
+/// Reads the first channel of a mains recording (WAV or any format [`crate::audio`] reads) at
+/// its own rate.
 pub fn read_wav(path: &Path) -> Result<Signal> {
-    let reader = hound::WavReader::open(path).map_err(|e| match e {
-        hound::Error::IoError(io) => anyhow::anyhow!("{}: {io}", path.display()),
-        other => anyhow::anyhow!("{}: not a readable WAV file ({other})", path.display()),
-    })?;
-    let spec = reader.spec();
-    let frames = reader.duration() as u64;
-    if frames > MAX_FRAMES {
-        bail!(
-            "{}: WAV header announces {frames} frames, more than eenf accepts",
-            path.display()
-        );
-    }
-    if spec.sample_rate == 0 || spec.channels == 0 {
-        bail!(
-            "{}: WAV header has a zero sample rate or no channels",
-            path.display()
-        );
-    }
-    let ch = spec.channels as usize;
-    let mut samples = Vec::with_capacity(frames as usize);
-    let bad = |e: hound::Error| anyhow::anyhow!("{}: damaged WAV data ({e})", path.display());
-    match spec.sample_format {
-        hound::SampleFormat::Int => {
-            let scale = 1.0 / (1u64 << (spec.bits_per_sample.clamp(1, 32) - 1)) as f64;
-            for (i, s) in reader.into_samples::<i32>().enumerate() {
-                let s = s.map_err(bad)?;
-                if i % ch == 0 {
-                    samples.push(s as f64 * scale);
-                }
-            }
-        }
-        hound::SampleFormat::Float => {
-            for (i, s) in reader.into_samples::<f32>().enumerate() {
-                let s = s.map_err(bad)?;
-                if i % ch == 0 {
-                    samples.push(s as f64);
-                }
-            }
-        }
-    }
-    if samples.is_empty() {
-        bail!("{}: the WAV holds no samples", path.display());
-    }
-    Ok(Signal {
-        fs: spec.sample_rate as f64,
-        samples,
-    })
+    let opts = crate::audio::AudioOptions {
+        channel: crate::audio::Channel::Index(0),
+        top_hz: None,
+    };
+    Ok(crate::audio::read_audio(path, &opts)?.signal)
 }
 
 /// Writes a mono 16-bit WAV (samples in ±1), whole or not at all.

@@ -1,0 +1,305 @@
+//! The sound of any recording: decoded with Symphonia (WAV, FLAC, MP3, AAC/M4A, OGG/Vorbis,
+//! MKV/WebM audio), or a video's soundtrack through the `ffmpeg` program; mixed to mono or one
+//! channel taken; brought down to the rate the mains bands need as it streams, so that an hour
+//! of 44.1 kHz audio never sits in memory at its own rate.
+
+use std::io::Read;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+use anyhow::{anyhow, bail, Context, Result};
+use eenf_dsp::StreamDecimator;
+use symphonia::core::audio::SampleBuffer;
+use symphonia::core::codecs::{DecoderOptions, CODEC_TYPE_NULL};
+use symphonia::core::errors::Error as SymError;
+use symphonia::core::formats::FormatOptions;
+use symphonia::core::io::MediaSourceStream;
+use symphonia::core::meta::MetadataOptions;
+use symphonia::core::probe::Hint;
+
+use crate::wav::Signal;
+
+/// Which channel of a recording is traced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Channel {
+    /// The mean of all channels.
+    #[default]
+    Mix,
+    /// One channel, from 0.
+    Index(usize),
+}
+
+impl std::str::FromStr for Channel {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "mix" => Ok(Channel::Mix),
+            n => n
+                .parse()
+                .map(Channel::Index)
+                .map_err(|_| format!("{s:?}: expected mix or a channel number from 0")),
+        }
+    }
+}
+
+impl std::fmt::Display for Channel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Channel::Mix => f.write_str("mix"),
+            Channel::Index(i) => write!(f, "{i}"),
+        }
+    }
+}
+
+/// How a recording's sound is read.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AudioOptions {
+    /// The channel traced.
+    pub channel: Channel,
+    /// Keep every band up to this frequency, Hz, and decimate to the lowest rate that does
+    /// (`None`: the recording's own rate).
+    pub top_hz: Option<f64>,
+}
+
+/// A recording's sound, as read.
+#[derive(Debug, Clone)]
+pub struct Audio {
+    /// The mono signal (decimated as asked).
+    pub signal: Signal,
+    /// The recording's own sample rate, Hz.
+    pub source_rate: f64,
+    /// Its channels.
+    pub channels: usize,
+    /// Frames decoded.
+    pub frames: u64,
+    /// What decoded it: `symphonia` or `ffmpeg`.
+    pub decoder: &'static str,
+}
+
+/// Mixes or picks one channel of interleaved frames and feeds the decimator.
+struct Sink {
+    channel: Channel,
+    channels: usize,
+    decimator: StreamDecimator,
+    mono: Vec<f64>,
+    out: Vec<f64>,
+    frames: u64,
+}
+
+impl Sink {
+    fn new(channel: Channel, channels: usize, fs: f64, top_hz: Option<f64>) -> Result<Self> {
+        if let Channel::Index(i) = channel {
+            if i >= channels {
+                bail!("channel {i} asked for, but the recording has {channels}");
+            }
+        }
+        Ok(Sink {
+            channel,
+            channels,
+            // no band above Nyquist: passes through
+            decimator: StreamDecimator::new(fs, top_hz.unwrap_or(fs)),
+            mono: Vec::new(),
+            out: Vec::new(),
+            frames: 0,
+        })
+    }
+
+    fn push(&mut self, interleaved: &[f32]) {
+        let ch = self.channels.max(1);
+        self.mono.clear();
+        match self.channel {
+            Channel::Index(i) => self
+                .mono
+                .extend(interleaved.chunks_exact(ch).map(|f| f[i] as f64)),
+            Channel::Mix if ch == 1 => self.mono.extend(interleaved.iter().map(|&v| v as f64)),
+            Channel::Mix => self.mono.extend(
+                interleaved
+                    .chunks_exact(ch)
+                    .map(|f| f.iter().map(|&v| v as f64).sum::<f64>() / ch as f64),
+            ),
+        }
+        self.frames += self.mono.len() as u64;
+        self.decimator.push(&self.mono, &mut self.out);
+    }
+}
+
+/// Reads the sound of `path` as `opts` says: Symphonia first, then ffmpeg for what it cannot
+/// read (video containers, other codecs). A damaged packet is skipped; a recording with no
+/// sound is an error.
+pub fn read_audio(path: &Path, opts: &AudioOptions) -> Result<Audio> {
+    let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
+    match read_symphonia(file, path, opts) {
+        Ok(a) => Ok(a),
+        Err(Unreadable::Format(why)) => read_ffmpeg(path, opts)
+            .map_err(|e| anyhow!("{}: {why}; {e}", path.display())),
+        Err(Unreadable::Other(e)) => Err(e),
+    }
+}
+
+/// Why Symphonia could not read a file: a format it does not know (ffmpeg may), or a real
+/// error (bad channel, damaged stream).
+enum Unreadable {
+    Format(String),
+    Other(anyhow::Error),
+}
+
+fn read_symphonia(
+    file: std::fs::File,
+    path: &Path,
+    opts: &AudioOptions,
+) -> std::result::Result<Audio, Unreadable> {
+    let other = |e: anyhow::Error| Unreadable::Other(anyhow!("{}: {e}", path.display()));
+    let mss = MediaSourceStream::new(Box::new(file), Default::default());
+    let mut hint = Hint::new();
+    if let Some(ext) = path.extension().and_then(|e| e.to_str()) {
+        hint.with_extension(ext);
+    }
+    let probed = symphonia::default::get_probe()
+        .format(&hint, mss, &FormatOptions::default(), &MetadataOptions::default())
+        .map_err(|e| Unreadable::Format(format!("not an audio format eenf reads itself ({e})")))?;
+    let mut format = probed.format;
+    let Some(track) = format
+        .tracks()
+        .iter()
+        .find(|t| t.codec_params.codec != CODEC_TYPE_NULL && t.codec_params.sample_rate.is_some())
+    else {
+        return Err(Unreadable::Format("no audio track eenf decodes itself".into()));
+    };
+    let track_id = track.id;
+    let params = track.codec_params.clone();
+    let mut decoder = symphonia::default::get_codecs()
+        .make(&params, &DecoderOptions::default())
+        .map_err(|e| Unreadable::Format(format!("its audio codec is not one eenf decodes ({e})")))?;
+    let fs = params.sample_rate.unwrap_or(0) as f64;
+    let mut sink: Option<Sink> = None;
+    let mut buf: Option<SampleBuffer<f32>> = None;
+    let mut damaged = 0usize;
+    loop {
+        let packet = match format.next_packet() {
+            Ok(p) => p,
+            Err(SymError::IoError(e)) if e.kind() == std::io::ErrorKind::UnexpectedEof => break,
+            Err(SymError::ResetRequired) => break,
+            Err(e) => return Err(other(anyhow!("damaged stream ({e})"))),
+        };
+        if packet.track_id() != track_id {
+            continue;
+        }
+        let decoded = match decoder.decode(&packet) {
+            Ok(d) => d,
+            Err(SymError::DecodeError(_)) => {
+                damaged += 1;
+                continue;
+            }
+            Err(SymError::IoError(e)) if e.kind() == std::io::ErrorKind::UnexpectedEof => break,
+            Err(e) => return Err(other(anyhow!("cannot decode its audio ({e})"))),
+        };
+        let spec = *decoded.spec();
+        let channels = spec.channels.count();
+        if sink.is_none() {
+            sink = Some(Sink::new(opts.channel, channels, fs, opts.top_hz).map_err(other)?);
+        }
+        let b = match &mut buf {
+            Some(b) if b.capacity() >= decoded.capacity() * channels => b,
+            _ => buf.insert(SampleBuffer::new(decoded.capacity() as u64, spec)),
+        };
+        b.copy_interleaved_ref(decoded);
+        if let Some(s) = sink.as_mut() {
+            if s.channels == channels {
+                s.push(b.samples());
+            }
+        }
+    }
+    if damaged > 0 {
+        eprintln!(
+            "warning: {}: {damaged} damaged audio packets skipped",
+            path.display()
+        );
+    }
+    finish(sink, fs, path, "symphonia").map_err(Unreadable::Other)
+}
+
+fn finish(sink: Option<Sink>, fs: f64, path: &Path, decoder: &'static str) -> Result<Audio> {
+    let Some(s) = sink.filter(|s| s.frames > 0) else {
+        bail!("{}: the recording holds no sound", path.display());
+    };
+    Ok(Audio {
+        signal: Signal {
+            fs: s.decimator.fs_out(),
+            samples: s.out,
+        },
+        source_rate: fs,
+        channels: s.channels,
+        frames: s.frames,
+        decoder,
+    })
+}
+
+/// The sound of `path` through ffmpeg: its first audio stream as 32-bit float frames on a
+/// pipe, at its own rate and channels (probed with ffprobe), decimated as it arrives.
+fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
+    let probe = Command::new("ffprobe")
+        .args(["-v", "error", "-select_streams", "a:0", "-show_entries"])
+        .args(["stream=sample_rate,channels", "-of", "csv=p=0"])
+        .arg(path)
+        .output()
+        .map_err(|e| match e.kind() {
+            std::io::ErrorKind::NotFound => {
+                anyhow!("ffmpeg (ffprobe) is not installed, and it is needed for this file (Debian: apt install ffmpeg)")
+            }
+            _ => anyhow!("ffprobe: {e}"),
+        })?;
+    let text = String::from_utf8_lossy(&probe.stdout);
+    let mut fields = text.trim().split(',');
+    let (Some(Ok(fs)), Some(Ok(channels))) = (
+        fields.next().map(|v| v.trim().parse::<u32>()),
+        fields.next().map(|v| v.trim().parse::<usize>()),
+    ) else {
+        bail!("ffmpeg finds no audio stream in it");
+    };
+    if fs == 0 || channels == 0 {
+        bail!("ffmpeg finds no audio stream in it");
+    }
+    let mut child = Command::new("ffmpeg")
+        .args(["-v", "error", "-nostdin", "-i"])
+        .arg(path)
+        .args(["-map", "0:a:0", "-vn", "-f", "f32le", "-acodec", "pcm_f32le", "-"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| anyhow!("ffmpeg: {e}"))?;
+    let mut sink = Sink::new(opts.channel, channels, fs as f64, opts.top_hz)?;
+    let mut stdout = child.stdout.take().expect("piped");
+    let mut bytes = vec![0u8; 1 << 16];
+    let mut carry = 0usize;
+    let mut frame = Vec::new();
+    let frame_bytes = 4 * channels;
+    loop {
+        let n = stdout.read(&mut bytes[carry..])?;
+        if n == 0 {
+            break;
+        }
+        let have = carry + n;
+        let whole = have / frame_bytes * frame_bytes;
+        frame.clear();
+        frame.extend(
+            bytes[..whole]
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        );
+        sink.push(&frame);
+        bytes.copy_within(whole..have, 0);
+        carry = have - whole;
+    }
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = e.read_to_string(&mut err);
+    }
+    let status = child.wait()?;
+    if !status.success() {
+        bail!(
+            "ffmpeg could not decode it: {}",
+            err.lines().next().unwrap_or("no message")
+        );
+    }
+    finish(Some(sink), fs as f64, path, "ffmpeg")
+}
