@@ -35,8 +35,7 @@ pub use butter::{butter_bandpass, butter_lowpass, sos_to_ba, Section};
 pub use decimate::{decimate, decimation_for, StreamDecimator};
 pub use enf::{
     check_line, detect_nominal, enf_from_flicker, enf_from_lines, extract_enf, line_prominence,
-    reference_enf,
-    DspError, EnfEstimates, EnfParams, HarmonicEstimates,
+    reference_enf, DspError, EnfEstimates, EnfParams, HarmonicEstimates,
 };
 pub use filtfilt::sosfiltfilt;
 pub use flicker::{

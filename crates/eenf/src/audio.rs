@@ -130,8 +130,9 @@ pub fn read_audio(path: &Path, opts: &AudioOptions) -> Result<Audio> {
     let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
     match read_symphonia(file, path, opts) {
         Ok(a) => Ok(a),
-        Err(Unreadable::Format(why)) => read_ffmpeg(path, opts)
-            .map_err(|e| anyhow!("{}: {why}; {e}", path.display())),
+        Err(Unreadable::Format(why)) => {
+            read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {why}; {e}", path.display()))
+        }
         Err(Unreadable::Other(e)) => Err(e),
     }
 }
@@ -155,7 +156,12 @@ fn read_symphonia(
         hint.with_extension(ext);
     }
     let probed = symphonia::default::get_probe()
-        .format(&hint, mss, &FormatOptions::default(), &MetadataOptions::default())
+        .format(
+            &hint,
+            mss,
+            &FormatOptions::default(),
+            &MetadataOptions::default(),
+        )
         .map_err(|e| Unreadable::Format(format!("not an audio format eenf reads itself ({e})")))?;
     let mut format = probed.format;
     let Some(track) = format
@@ -163,13 +169,17 @@ fn read_symphonia(
         .iter()
         .find(|t| t.codec_params.codec != CODEC_TYPE_NULL && t.codec_params.sample_rate.is_some())
     else {
-        return Err(Unreadable::Format("no audio track eenf decodes itself".into()));
+        return Err(Unreadable::Format(
+            "no audio track eenf decodes itself".into(),
+        ));
     };
     let track_id = track.id;
     let params = track.codec_params.clone();
     let mut decoder = symphonia::default::get_codecs()
         .make(&params, &DecoderOptions::default())
-        .map_err(|e| Unreadable::Format(format!("its audio codec is not one eenf decodes ({e})")))?;
+        .map_err(|e| {
+            Unreadable::Format(format!("its audio codec is not one eenf decodes ({e})"))
+        })?;
     let fs = params.sample_rate.unwrap_or(0) as f64;
     let mut sink: Option<Sink> = None;
     let mut buf: Option<SampleBuffer<f32>> = None;
@@ -222,10 +232,14 @@ fn finish(sink: Option<Sink>, fs: f64, path: &Path, decoder: &'static str) -> Re
     let Some(s) = sink.filter(|s| s.frames > 0) else {
         bail!("{}: the recording holds no sound", path.display());
     };
+    // the decimator's delay taken back out, so sample 0 is the recording's start
+    let lag = (s.decimator.delay_s() * s.decimator.fs_out()).round() as usize;
+    let mut samples = s.out;
+    samples.drain(..lag.min(samples.len()));
     Ok(Audio {
         signal: Signal {
             fs: s.decimator.fs_out(),
-            samples: s.out,
+            samples,
         },
         source_rate: fs,
         channels: s.channels,
@@ -262,7 +276,16 @@ fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
     let mut child = Command::new("ffmpeg")
         .args(["-v", "error", "-nostdin", "-i"])
         .arg(path)
-        .args(["-map", "0:a:0", "-vn", "-f", "f32le", "-acodec", "pcm_f32le", "-"])
+        .args([
+            "-map",
+            "0:a:0",
+            "-vn",
+            "-f",
+            "f32le",
+            "-acodec",
+            "pcm_f32le",
+            "-",
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()

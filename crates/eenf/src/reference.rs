@@ -9,12 +9,12 @@ use eenf_dsp::{
     check_line, detect_nominal, enf_from_lines, line_prominence, reference_enf, EnfParams,
 };
 
+use crate::audio::{read_audio, AudioOptions};
 use crate::dataset::hourly_references;
 use crate::extract::Nominal;
 use crate::progress::Progress;
 use crate::refdb::{RefSeries, GAP};
 use crate::time::LocalTime;
-use crate::audio::{read_audio, AudioOptions};
 use crate::trace::{AudioProvenance, MainsProvenance, Provenance, Trace};
 use crate::wav::{read_wav, Signal};
 
@@ -56,7 +56,7 @@ fn hum_nominal(sig: &Signal, nominal: Nominal, harmonics: usize, path: &Path) ->
     let grids: &[f64] = match nominal {
         Nominal::Auto => &[50.0, 60.0],
         Nominal::Hz(f) => std::slice::from_ref(match f {
-            f if f == 50.0 => &50.0,
+            50.0 => &50.0,
             _ => &60.0,
         }),
     };
@@ -75,6 +75,9 @@ fn hum_nominal(sig: &Signal, nominal: Nominal, harmonics: usize, path: &Path) ->
     Ok(f0)
 }
 
+/// Lines looked for when a recording has none at f0.
+pub const FALLBACK_HARMONICS: usize = 3;
+
 /// The ENF of a recording's sound (a mains recording, a voice recorder, a video's soundtrack):
 /// read as `audio` says, decimated to what `harmonics` lines need, and tracked on f0 alone
 /// (`harmonics` 1: the method's reference tracker, unfiltered) or on f0 … N·f0, band by band,
@@ -91,11 +94,31 @@ pub fn audio_trace(
         Nominal::Hz(f) => f,
         Nominal::Auto => 60.0,
     };
-    let opts = AudioOptions {
-        top_hz: Some(harmonics as f64 * grid + params.half_band_hz + 4.0),
-        ..*audio
+    let read = |harmonics: usize| {
+        let opts = AudioOptions {
+            top_hz: Some(harmonics as f64 * grid + params.half_band_hz + 4.0),
+            ..*audio
+        };
+        read_audio(path, &opts)
     };
-    let a = read_audio(path, &opts)?;
+    let mut a = read(harmonics)?;
+    // no line at f0 (a device whose hum sits at 2f0 or 3f0): read again with room for its
+    // harmonics, and track them instead
+    let mut fundamental = match harmonics {
+        1 => Some(mains_nominal(&a.signal, nominal, path)),
+        _ => None,
+    };
+    let mut harmonics = harmonics;
+    if let Some(Err(_)) = fundamental {
+        let wider = read(FALLBACK_HARMONICS)?;
+        if hum_nominal(&wider.signal, nominal, FALLBACK_HARMONICS, path).is_ok() {
+            eprintln!(
+                "note: {}: no mains line at f0; its harmonics up to {FALLBACK_HARMONICS} x f0 are tracked",
+                path.display()
+            );
+            (a, harmonics, fundamental) = (wider, FALLBACK_HARMONICS, None);
+        }
+    }
     let sig = &a.signal;
     let provenance_audio = AudioProvenance {
         decoder: a.decoder.to_string(),
@@ -105,8 +128,8 @@ pub fn audio_trace(
         channel: audio.channel.to_string(),
         frames: a.frames,
     };
-    if harmonics == 1 {
-        let f0 = mains_nominal(sig, nominal, path)?;
+    if let (1, Some(f0)) = (harmonics, fundamental) {
+        let f0 = f0?;
         let p = EnfParams {
             nominal_hz: f0,
             ..params.clone()
@@ -137,7 +160,7 @@ pub fn audio_trace(
         MainsProvenance {
             peak: p.peak,
             window_s: p.window_s,
-            harmonics,
+            mains_lines: harmonics,
             audio: Some(provenance_audio),
         },
     ))

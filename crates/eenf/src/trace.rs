@@ -116,7 +116,7 @@ pub struct MainsProvenance {
     pub window_s: f64,
     /// Mains lines tracked (f0 … N·f0); 1 is the method's reference tracker on f0 alone.
     #[serde(default = "one")]
-    pub harmonics: usize,
+    pub mains_lines: usize,
     /// How the sound was read, when it was (decoder, rates, channel).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub audio: Option<AudioProvenance>,
@@ -301,7 +301,7 @@ impl Trace {
             provenance: Some(Provenance::Mains(MainsProvenance {
                 peak: params.peak,
                 window_s: params.window_s,
-                harmonics: 1,
+                mains_lines: 1,
                 audio: None,
             })),
             ..Trace::new(params.step_s, enf_hz)
