@@ -79,6 +79,19 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
+            // a reader that went away (`| head`) ends the program quietly
+            let closed = e.chain().any(|c| {
+                let io = c.downcast_ref::<std::io::Error>().or_else(|| {
+                    match c.downcast_ref::<csv::Error>().map(csv::Error::kind) {
+                        Some(csv::ErrorKind::Io(io)) => Some(io),
+                        _ => None,
+                    }
+                });
+                io.is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            });
+            if closed {
+                return ExitCode::SUCCESS;
+            }
             // one line: the causes joined, each naming what it is about
             eprintln!("eenf: error: {e:#}");
             ExitCode::FAILURE

@@ -311,3 +311,74 @@ fn a_recording_without_flicker_names_the_strongest_line_and_its_height() {
     assert!(err.contains("above the noise (6x needed)"), "{err}");
     assert_eq!(err.trim().lines().count(), 1, "{err}");
 }
+
+/// A reader that goes away (`| head -1`) ends eenf quietly; a full stdout (`> /dev/full`) is
+/// a one-line error, never a panic.
+#[test]
+fn a_closed_pipe_is_quiet_and_a_full_stdout_one_line() {
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let rec = simulate(d, "pipe.aedat4", "20");
+    // an hour of mains: 3601 lines, more than a pipe holds, so the write meets the closed end
+    let (ok, _, err) = eenf(
+        &[
+            "-q",
+            "simulate",
+            "--duration",
+            "20",
+            "--resolution",
+            "8x6",
+            "-o",
+            "r.aedat4",
+            "--reference-dir",
+            "refs",
+        ],
+        d,
+    );
+    assert!(ok, "{err}");
+    let hour = std::fs::read_dir(d.join("refs"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    for args in [
+        vec!["-q", "reference", hour.to_str().unwrap()],
+        vec!["-q", "extract", rec.to_str().unwrap()],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_eenf"))
+            .args(&args)
+            .current_dir(d)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut first)
+            .unwrap();
+        assert!(!first.is_empty(), "{args:?}");
+        // the reader is gone: the rest of the output meets a closed pipe
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {err}");
+        assert!(
+            !err.contains("Broken pipe") && !err.contains("panicked"),
+            "{err}"
+        );
+    }
+    if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
+        let out = Command::new(env!("CARGO_BIN_EXE_eenf"))
+            .args(["-q", "info", rec.to_str().unwrap()])
+            .stdout(full)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(!err.contains("panicked"), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains("No space left"), "{err}");
+    }
+}

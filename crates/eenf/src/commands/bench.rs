@@ -122,7 +122,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
 
     // the tables on stdout; failures on stderr
     for run in &runs {
-        println!("{}", markdown_table(run, &methods));
+        outln!("{}", markdown_table(run, &methods));
         for o in run.outcomes.iter() {
             if let Err(e) = &o.result {
                 eprintln!(

@@ -74,17 +74,17 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             "seconds": m.n, "cc": m.cc, "mae_hz": m.mae_hz, "rmse_hz": m.rmse_hz,
             "max_err_hz": m.max_err_hz, "plot": a.plot,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!("estimate   {}", a.estimate.display());
-        println!("reference  {}", a.reference.display());
-        println!("seconds    {}", m.n);
-        println!("CC         {:.4}", m.cc);
-        println!("MAE        {:.3} mHz", m.mae_hz * 1e3);
-        println!("RMSE       {:.3} mHz", m.rmse_hz * 1e3);
-        println!("max error  {:.3} mHz", m.max_err_hz * 1e3);
+        outln!("estimate   {}", a.estimate.display());
+        outln!("reference  {}", a.reference.display());
+        outln!("seconds    {}", m.n);
+        outln!("CC         {:.4}", m.cc);
+        outln!("MAE        {:.3} mHz", m.mae_hz * 1e3);
+        outln!("RMSE       {:.3} mHz", m.rmse_hz * 1e3);
+        outln!("max error  {:.3} mHz", m.max_err_hz * 1e3);
         if let Some(p) = &a.plot {
-            println!("plot       {}", p.display());
+            outln!("plot       {}", p.display());
         }
     }
     Ok(())

@@ -30,7 +30,7 @@ pub struct Args {
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("{}", a.out_dir.display()))?;
     let recording = a.out_dir.join("demo.aedat4");
-    println!(
+    outln!(
         "1/3 simulating {:.0} s of a lamp-lit scene on a 50 Hz grid...",
         a.duration
     );
@@ -41,14 +41,14 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     }
     .with_kinds(&[SceneKind::Static]);
     let sim = simulate_recording(&Recipe::new(config, recording.clone()), &progress)?.sim;
-    println!(
+    outln!(
         "    {} events in {:.1} s -> {}",
         sim.stats.events,
         sim.seconds,
         recording.display()
     );
 
-    println!("2/3 extracting the ENF from the events (E-ENF)...");
+    outln!("2/3 extracting the ENF from the events (E-ENF)...");
     let started = std::time::Instant::now();
     let opts = ExtractOptions {
         nominal: Nominal::Auto,
@@ -66,7 +66,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         "demo: ENF per harmonic and the selected harmonic",
         &trace,
     )?;
-    println!(
+    outln!(
         "    detected a {} Hz grid; {} estimates in {:.2} s -> {}",
         trace.nominal_hz.unwrap_or(f64::NAN),
         trace.enf_hz.len(),
@@ -74,7 +74,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         trace_csv.display()
     );
 
-    println!("3/3 comparing with the simulator's ground truth...");
+    outln!("3/3 comparing with the simulator's ground truth...");
     let est = Trace::read(&trace_csv, None)?;
     let c = compare_trace(
         &est,
@@ -97,17 +97,17 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         &c.estimate,
         &c.reference,
     )?;
-    println!();
-    println!("CC   {:.4}", m.cc);
-    println!(
+    outln!();
+    outln!("CC   {:.4}", m.cc);
+    outln!(
         "MAE  {:.3} mHz  (RMSE {:.3} mHz, max {:.3} mHz, {} s compared)",
         m.mae_hz * 1e3,
         m.rmse_hz * 1e3,
         m.max_err_hz * 1e3,
         m.n
     );
-    println!();
-    println!("files in {}:", a.out_dir.display());
+    outln!();
+    outln!("files in {}:", a.out_dir.display());
     for p in [
         &recording,
         &sim.truth,
@@ -116,7 +116,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         &extract_plot,
         &compare_plot,
     ] {
-        println!("  {}", p.display());
+        outln!("  {}", p.display());
     }
     Ok(())
 }

@@ -49,7 +49,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     );
     eprintln!("map written to {}", a.output.display());
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&map)?);
+        outln!("{}", serde_json::to_string_pretty(&map)?);
     }
     Ok(())
 }

@@ -88,17 +88,17 @@ pub fn run(a: Args) -> Result<()> {
             "sampling": sampling.as_ref().map(|s| serde_json::json!({"auto": s.0, "why": s.1})),
             "flicker": found.flicker,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    println!("file        {}", a.file.display());
+    outln!("file        {}", a.file.display());
     match &info.codec {
-        Some(c) => println!("format      {} (compression {c})", info.format),
-        None => println!("format      {}", info.format),
+        Some(c) => outln!("format      {} (compression {c})", info.format),
+        None => outln!("format      {}", info.format),
     }
     match (width, height) {
-        (Some(w), Some(h)) => println!("resolution  {w} x {h}"),
-        _ => println!("resolution  unknown"),
+        (Some(w), Some(h)) => outln!("resolution  {w} x {h}"),
+        _ => outln!("resolution  unknown"),
     }
     if !info.streams.is_empty() {
         let list: Vec<String> = info
@@ -109,31 +109,31 @@ pub fn run(a: Args) -> Result<()> {
                 _ => format!("{} {}", s.id, s.kind),
             })
             .collect();
-        println!("streams     {}", list.join(", "));
+        outln!("streams     {}", list.join(", "));
     }
-    println!(
+    outln!(
         "events      {} ({} ON, {} OFF)",
         stats.events,
         stats.on,
         stats.events - stats.on
     );
     if let (Some(f), Some(l)) = (stats.first_t, stats.last_t) {
-        println!("first t     {f} us ({})", utc_micros(f));
-        println!("last t      {l} us ({})", utc_micros(l));
-        println!("duration    {duration_s:.6} s");
-        println!("rate        {:.3} M events/s", rate / 1e6);
+        outln!("first t     {f} us ({})", utc_micros(f));
+        outln!("last t      {l} us ({})", utc_micros(l));
+        outln!("duration    {duration_s:.6} s");
+        outln!("rate        {:.3} M events/s", rate / 1e6);
     }
     if !info.cameras.is_empty() {
-        println!("cameras     {}", info.cameras.join("; "));
+        outln!("cameras     {}", info.cameras.join("; "));
     }
     if let Some((method, why)) = &sampling {
-        println!("sampling    auto → {method} ({why})");
+        outln!("sampling    auto → {method} ({why})");
     }
     for f in &found.flicker {
-        println!("flicker     {}", flicker_text(f));
+        outln!("flicker     {}", flicker_text(f));
     }
     for n in &info.notes {
-        println!("note        {n}");
+        outln!("note        {n}");
     }
     Ok(())
 }

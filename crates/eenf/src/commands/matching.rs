@@ -144,21 +144,27 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
                 "mae_hz": v.agreement.mae_hz, "rmse_hz": v.agreement.rmse_hz, "rank": v.rank, "p_value": v.p_value,
                 "best_fit": v.rank == 1, "consistent": v.rank == 1 && v.p_value < a.alpha})),
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{} ({} values, {} Hz grid) searched in {took:.2} s",
         a.trace.display(),
         trace.enf_hz.len(),
         nominal
     );
-    println!(
+    outln!(
         "{:>4}  {:<28} {:>8} {:>9} {:>9} {:>8} {:>9}",
-        "rank", "start", "CC", "MAE mHz", "RMSE mHz", "overlap", "p"
+        "rank",
+        "start",
+        "CC",
+        "MAE mHz",
+        "RMSE mHz",
+        "overlap",
+        "p"
     );
     for (i, (r, c)) in rows.iter().enumerate() {
-        println!(
+        outln!(
             "{:>4}  {:<28} {:>8.4} {:>9.3} {:>9.3} {:>8} {:>9.1e}{}",
             i + 1,
             when(r, c.offset),
@@ -172,7 +178,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     }
     if let Some(t) = &a.verify {
         match verification {
-            Some((r, v)) => println!(
+            Some((r, v)) => outln!(
                 "claimed {t} ({}): CC {:.4}, MAE {:.3} mHz, rank {}, p {:.1e}: {}",
                 when(r, v.offset as f64),
                 v.agreement.cc,
@@ -185,7 +191,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
                     (false, _) => format!("not supported: {} other places fit better", v.rank - 1),
                 }
             ),
-            None => println!("claimed {t}: outside the reference"),
+            None => outln!("claimed {t}: outside the reference"),
         }
     }
     Ok(())

@@ -131,20 +131,20 @@ fn info(store: &Path) -> Result<()> {
             .count()
             + usize::from(s.values.first() == Some(&GAP));
         let end = m.start_unix_s + (s.values.len().max(1) - 1) as f64 * m.step_s;
-        println!("grid        {}", m.grid);
-        println!("nominal     {} Hz", m.nominal_hz);
-        println!("step        {} s", m.step_s);
-        println!("from        {}", utc(m.start_unix_s));
-        println!("to          {}", utc(end));
-        println!(
+        outln!("grid        {}", m.grid);
+        outln!("nominal     {} Hz", m.nominal_hz);
+        outln!("step        {} s", m.step_s);
+        outln!("from        {}", utc(m.start_unix_s));
+        outln!("to          {}", utc(end));
+        outln!(
             "values      {} ({:.1} % covered, {} gaps in {} runs)",
             s.values.len(),
             100.0 * (s.values.len() - gaps) as f64 / s.values.len().max(1) as f64,
             gaps,
             runs
         );
-        println!("size        {:.1} MB", s.values.len() as f64 * 4.0 / 1e6);
-        println!();
+        outln!("size        {:.1} MB", s.values.len() as f64 * 4.0 / 1e6);
+        outln!();
     }
     Ok(())
 }
