@@ -184,8 +184,15 @@ fn other_formats_give_the_wavs_trace() {
     for f in ["hum.mp3", "hum.flac", "hum.m4a", "hum.ogg"] {
         convert(&["-i", "hum.wav", f]);
         let t = trace_of(&ok(&["-q", "audio", f], d));
-        assert_eq!(t.len(), wav.len(), "{f}");
-        let a = agreement(&t, &wav).unwrap();
+        // an encoder's padding may add a fraction of a second, so one more estimate
+        assert!(
+            t.len().abs_diff(wav.len()) <= 1,
+            "{f}: {} vs {}",
+            t.len(),
+            wav.len()
+        );
+        let n = t.len().min(wav.len());
+        let a = agreement(&t[..n], &wav[..n]).unwrap();
         assert!(a.mae_hz < 5e-4, "{f}: {a:?}");
     }
     convert(&[
