@@ -55,6 +55,9 @@ pub(crate) fn looks_like_event_line(line: &str) -> bool {
     }
 }
 
+/// The largest time a text file may give, µs from its epoch.
+const MAX_ABS_TIME_US: f64 = 1e17;
+
 fn parse_line(
     line: &str,
     unit: TimeUnit,
@@ -67,18 +70,25 @@ fn parse_line(
     let x = next("x")?;
     let y = next("y")?;
     let p = next("polarity")?;
+    // a time must be a finite number within ±10¹⁷ µs (3000 years): `nan`, `inf` and 26-digit
+    // values are damage, not times
+    let in_range = |us: f64| {
+        if us.is_finite() && us.abs() <= MAX_ABS_TIME_US {
+            Ok(us.round() as i64)
+        } else {
+            Err(format!("time {t:?} is not a time eenf accepts"))
+        }
+    };
     let t = match unit {
         TimeUnit::Micros => match t.parse::<i64>() {
-            Ok(v) => v,
+            Ok(v) if v.unsigned_abs() <= MAX_ABS_TIME_US as u64 => v,
+            Ok(_) => in_range(f64::INFINITY)?,
             // A float in a file of integers: still microseconds.
-            Err(_) => t
-                .parse::<f64>()
-                .map_err(|_| format!("bad time {t:?}"))?
-                .round() as i64,
+            Err(_) => in_range(t.parse::<f64>().map_err(|_| format!("bad time {t:?}"))?)?,
         },
         TimeUnit::Seconds => {
             let s: f64 = t.parse().map_err(|_| format!("bad time {t:?}"))?;
-            (s * 1e6).round() as i64
+            in_range(s * 1e6)?
         }
     };
     let coord = |v: &str, what: &str| -> std::result::Result<u16, String> {
@@ -94,15 +104,22 @@ fn parse_line(
     };
     let x = coord(x, "x")?;
     let y = coord(y, "y")?;
-    let p: f64 = p.parse().map_err(|_| format!("bad polarity {p:?}"))?;
+    let p: f64 = p
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite())
+        .ok_or_else(|| format!("bad polarity {p:?}"))?;
     Ok(Some((t, x, y, p > 0.0)))
 }
 
 /// Streams events from a text file.
 pub struct TextReader {
     path: PathBuf,
-    lines: std::io::Lines<BufReader<Box<dyn Source>>>,
+    lines: BufReader<Box<dyn Source>>,
+    line: String,
     line_no: u64,
+    /// Byte offset of the next line.
+    offset: u64,
     unit: TimeUnit,
     info: StreamInfo,
     done: bool,
@@ -138,8 +155,10 @@ impl TextReader {
         f.seek(SeekFrom::Start(0)).map_err(|e| io_err(path, e))?;
         Ok(TextReader {
             path: path.to_path_buf(),
-            lines: BufReader::with_capacity(1 << 20, f).lines(),
+            lines: BufReader::with_capacity(1 << 20, f),
+            line: String::new(),
             line_no: 0,
+            offset: 0,
             unit,
             info: StreamInfo {
                 format: FORMAT,
@@ -162,16 +181,23 @@ impl EventReader for TextReader {
         }
         let mut batch = EventBatch::with_capacity(BATCH);
         while batch.len() < BATCH {
-            let Some(line) = self.lines.next() else {
+            self.line.clear();
+            let read = self
+                .lines
+                .read_line(&mut self.line)
+                .map_err(|e| io_err(&self.path, e))?;
+            if read == 0 {
                 self.done = true;
                 break;
-            };
+            }
+            let at = self.offset;
+            self.offset += read as u64;
             self.line_no += 1;
-            let line = line.map_err(|e| io_err(&self.path, e))?;
-            if !self.seen_data && is_column_names(&line) {
+            let line = self.line.trim_end_matches(['\n', '\r']);
+            if !self.seen_data && is_column_names(line) {
                 continue;
             }
-            match parse_line(&line, self.unit) {
+            match parse_line(line, self.unit) {
                 Ok(Some((t, x, y, p))) => {
                     self.seen_data = true;
                     batch.push(t, x, y, p)
@@ -182,7 +208,7 @@ impl EventReader for TextReader {
                     return Err(EventError::Corrupt {
                         path: self.path.clone(),
                         format: FORMAT,
-                        offset: self.line_no,
+                        offset: at,
                         reason: format!("line {}: {reason}", self.line_no),
                     });
                 }
@@ -214,5 +240,28 @@ mod tests {
             parse_line("1.5e-6 0 0 0", TimeUnit::Seconds).unwrap(),
             Some((2, 0, 0, false))
         );
+    }
+
+    #[test]
+    fn non_finite_and_absurd_values_are_refused_where_they_are() {
+        for (line, unit) in [
+            ("nan 1 2 1", TimeUnit::Seconds),
+            ("inf 1 2 1", TimeUnit::Micros),
+            ("-inf 1 2 1", TimeUnit::Seconds),
+            ("12345678901234567890123456 1 2 1", TimeUnit::Micros),
+            ("1e12 1 2 1", TimeUnit::Seconds),
+            ("5 1 2 nan", TimeUnit::Micros),
+        ] {
+            assert!(parse_line(line, unit).is_err(), "{line}");
+        }
+        // the error names the line and the byte where it starts
+        let text = "t x y p\n10 1 2 1\n20 1 2 0\nnan 1 2 1\n";
+        let mut r = TextReader::new(
+            Box::new(std::io::Cursor::new(text.as_bytes().to_vec())),
+            Path::new("e.txt"),
+        )
+        .unwrap();
+        let e = r.next_batch().unwrap_err().to_string();
+        assert!(e.contains("at byte 26") && e.contains("line 4"), "{e}");
     }
 }
