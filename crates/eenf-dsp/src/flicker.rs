@@ -45,17 +45,22 @@ impl FlickerLine {
     }
 }
 
-/// The magnitude spectrum of `x` under a Hann window, zero-padded four times (at most 2^24
-/// points), its bin width, and its median magnitude in [`NOISE_BAND`].
-fn spectrum(x: &[f64], fs: f64) -> Option<(Vec<f64>, f64, f64)> {
+/// The magnitude spectrum of `x` under a Hann window, zero-padded `pad` times (at most 2^24
+/// points), its bin width, and its median magnitude in [`NOISE_BAND`]. Plans are kept per
+/// thread: a flicker map asks this of a thousand tiles.
+fn spectrum(x: &[f64], fs: f64, pad: usize) -> Option<(Vec<f64>, f64, f64)> {
     if fs < 2.0 * NOISE_BAND.1 + 20.0 || (x.len() as f64) < fs {
         return None;
     }
-    let nfft = (4 * x.len())
+    thread_local! {
+        static PLANNER: std::cell::RefCell<RealFftPlanner<f64>> =
+            std::cell::RefCell::new(RealFftPlanner::new());
+    }
+    let nfft = (pad * x.len())
         .next_power_of_two()
         .min(1 << 24)
         .max(x.len().next_power_of_two());
-    let fft = RealFftPlanner::<f64>::new().plan_fft_forward(nfft);
+    let fft = PLANNER.with(|p| p.borrow_mut().plan_fft_forward(nfft));
     let mut input = fft.make_input_vec();
     let n = x.len();
     let mean = x.iter().sum::<f64>() / n as f64;
@@ -75,40 +80,14 @@ fn spectrum(x: &[f64], fs: f64) -> Option<(Vec<f64>, f64, f64)> {
 }
 
 /// How far `x` stands above its noise at `hz` (a line found elsewhere, e.g. over the whole
-/// sensor): its magnitude there (the largest of the three nearest bins) over the median
-/// magnitude in 80–140 Hz. About 1 where there is no line. Unpadded, with the plans kept per
-/// thread: a flicker map asks this of a thousand tiles.
+/// sensor): its magnitude there (the largest of the three nearest bins, unpadded) over the
+/// median magnitude in 80–140 Hz. About 1 where there is no line.
 pub fn line_strength_at(x: &[f64], fs: f64, hz: f64) -> Option<f64> {
-    if fs < 2.0 * NOISE_BAND.1 + 20.0 || (x.len() as f64) < fs {
-        return None;
-    }
-    thread_local! {
-        static PLANNER: std::cell::RefCell<RealFftPlanner<f64>> =
-            std::cell::RefCell::new(RealFftPlanner::new());
-    }
-    let nfft = x.len().next_power_of_two();
-    let fft = PLANNER.with(|p| p.borrow_mut().plan_fft_forward(nfft));
-    let mut input = fft.make_input_vec();
-    let n = x.len();
-    let mean = x.iter().sum::<f64>() / n as f64;
-    for (i, (d, s)) in input.iter_mut().zip(x).enumerate() {
-        let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos();
-        *d = (s - mean) * w;
-    }
-    let mut spec = fft.make_output_vec();
-    fft.process(&mut input, &mut spec).ok()?;
-    let df = fs / nfft as f64;
-    let bin = |f: f64| ((f / df).round() as usize).min(spec.len() - 1);
-    let mut noise: Vec<f64> = spec[bin(NOISE_BAND.0)..=bin(NOISE_BAND.1)]
+    let (mag, df, median) = spectrum(x, fs, 1)?;
+    let at = ((hz / df).round() as usize).min(mag.len() - 1);
+    let peak = mag[at.saturating_sub(1)..=(at + 1).min(mag.len() - 1)]
         .iter()
-        .map(|c| c.norm())
-        .collect();
-    let k = noise.len() / 2;
-    let median = *noise.select_nth_unstable_by(k, f64::total_cmp).1;
-    let at = bin(hz);
-    let peak = spec[at.saturating_sub(1)..=(at + 1).min(spec.len() - 1)]
-        .iter()
-        .fold(0.0f64, |a, c| a.max(c.norm()));
+        .fold(0.0f64, |a, &m| a.max(m));
     (median > 0.0).then(|| peak / median)
 }
 
@@ -122,7 +101,7 @@ pub fn flicker_line(x: &[f64], fs: f64) -> Option<FlickerLine> {
 /// `fs` (at least 300 Hz; at least one second of signal). `None` when the signal is too short
 /// or too slow.
 pub fn flicker_lines(x: &[f64], fs: f64) -> Option<[FlickerLine; 2]> {
-    let (mag, df, median) = spectrum(x, fs)?;
+    let (mag, df, median) = spectrum(x, fs, 4)?;
     let bin = |f: f64| ((f / df).round() as usize).min(mag.len() - 1);
     let peak = |(lo, hi): (f64, f64)| {
         let (a, b) = (bin(lo), bin(hi));

@@ -61,6 +61,15 @@ fn sinusoid_lamp(depth: f64) -> Vec<Lamp> {
     }]
 }
 
+/// The default fluorescent tube, alone: deep modulation and many harmonics (bursts of events).
+fn fluorescent_lamp() -> Vec<Lamp> {
+    vec![Lamp {
+        kind: LampKind::named("fluorescent").unwrap(),
+        phase_deg: 0.0,
+        share: 1.0,
+    }]
+}
+
 /// Amplitude of the line at `f` in `x` sampled at `fs` (one DFT bin at exactly f).
 fn line(x: &[f64], f: f64, fs: f64) -> f64 {
     let (mut re, mut im) = (0.0, 0.0);
@@ -310,11 +319,7 @@ fn camera_shake_and_objects_make_events_without_flicker() {
 fn the_dvxplorer_readout_groups_events_in_scans_and_has_a_finite_bandwidth() {
     let seconds = 0.5;
     let mains = steady_50hz(seconds + 1.0);
-    let fluorescent = vec![Lamp {
-        kind: LampKind::named("fluorescent").unwrap(),
-        phase_deg: 0.0,
-        share: 1.0,
-    }];
+    let fluorescent = fluorescent_lamp();
     let free = SimConfig {
         width: 128,
         height: 96,
@@ -378,11 +383,7 @@ fn the_dvxplorer_readout_groups_events_in_scans_and_has_a_finite_bandwidth() {
 fn the_dvs128_arbiter_serves_one_event_at_a_time_at_its_bus_rate() {
     let seconds = 0.5;
     let mains = steady_50hz(seconds + 1.0);
-    let fluorescent = vec![Lamp {
-        kind: LampKind::named("fluorescent").unwrap(),
-        phase_deg: 0.0,
-        share: 1.0,
-    }];
+    let fluorescent = fluorescent_lamp();
     let scene = SimConfig {
         width: 64,
         height: 48,

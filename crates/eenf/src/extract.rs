@@ -175,41 +175,39 @@ pub fn grid_line(path: &Path, open: &OpenOptions, grid_hz: f64) -> Result<Option
 pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> Result<Sampled> {
     let reader = eenf_events::open_with(path, &opts.open)?;
     let cameras = reader.info().cameras.len();
-    if cameras < 2 || opts.open.camera.is_some() {
-        let mask = tile_mask(path, &opts.open, opts, progress)?;
-        let reader = match mask {
-            Some(_) => eenf_events::open_with(path, &opts.open)?,
-            None => reader,
-        };
-        return sample_reader(
-            reader,
-            path,
-            opts.sampling,
-            opts.dt_us,
-            mask.as_ref(),
-            progress,
-        );
-    }
-    let mut best: Option<(u8, f64)> = None;
-    let mut heard = Vec::new();
-    for c in 0..cameras.min(u8::MAX as usize) as u8 {
-        let line = camera_line(path, &opts.open, c, SamplingMethod::Sum)?;
-        let prominence = line.map_or(0.0, |l| l.prominence);
-        heard.push(match line {
-            Some(l) => format!("camera {c}: {:.3} Hz, {:.1}x", l.hz, l.prominence),
-            None => format!("camera {c}: no line"),
-        });
-        if best.is_none_or(|b| prominence > b.1) {
-            best = Some((c, prominence));
+    // the reader opened above serves when it is the one to read
+    let (reader, open, note) = if cameras < 2 || opts.open.camera.is_some() {
+        (Some(reader), opts.open.clone(), None)
+    } else {
+        let mut best: Option<(u8, f64)> = None;
+        let mut heard = Vec::new();
+        for c in 0..cameras.min(u8::MAX as usize) as u8 {
+            let line = camera_line(path, &opts.open, c, SamplingMethod::Sum)?;
+            let prominence = line.map_or(0.0, |l| l.prominence);
+            heard.push(match line {
+                Some(l) => format!("camera {c}: {:.3} Hz, {:.1}x", l.hz, l.prominence),
+                None => format!("camera {c}: no line"),
+            });
+            if best.is_none_or(|b| prominence > b.1) {
+                best = Some((c, prominence));
+            }
         }
-    }
-    let (camera, _) = best.unwrap_or((0, 0.0));
-    let open = OpenOptions {
-        camera: Some(camera),
-        ..opts.open.clone()
+        let (camera, _) = best.unwrap_or((0, 0.0));
+        let note = format!(
+            "{cameras} cameras: camera {camera} traced, its flicker stands highest ({}); --camera picks another",
+            heard.join("; ")
+        );
+        let open = OpenOptions {
+            camera: Some(camera),
+            ..opts.open.clone()
+        };
+        (None, open, Some(note))
     };
     let mask = tile_mask(path, &open, opts, progress)?;
-    let reader = eenf_events::open_with(path, &open)?;
+    let reader = match (reader, &mask) {
+        (Some(r), None) => r,
+        _ => eenf_events::open_with(path, &open)?,
+    };
     let mut s = sample_reader(
         reader,
         path,
@@ -218,10 +216,7 @@ pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> R
         mask.as_ref(),
         progress,
     )?;
-    s.notes.push(format!(
-        "{cameras} cameras: camera {camera} traced, its flicker stands highest ({}); --camera picks another",
-        heard.join("; ")
-    ));
+    s.notes.extend(note);
     Ok(s)
 }
 
