@@ -6,12 +6,13 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum EventError {
     /// The file could not be opened, read or written.
-    #[error("{path}: {source}")]
+    // the OS message is shown once: not also as a `source` that `{:#}` would print again
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// The underlying error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The content is not a format eenf knows.
     #[error("{path}: not a supported event file ({reason}); supported: {supported}")]
@@ -63,6 +64,6 @@ pub type Result<T> = std::result::Result<T, EventError>;
 pub(crate) fn io_err(path: &std::path::Path, source: std::io::Error) -> EventError {
     EventError::Io {
         path: path.to_path_buf(),
-        source,
+        error: source,
     }
 }
