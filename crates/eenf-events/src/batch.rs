@@ -46,6 +46,14 @@ impl EventBatch {
         self.p.push(p);
     }
 
+    /// Keeps the first `n` events.
+    pub fn truncate(&mut self, n: usize) {
+        self.t.truncate(n);
+        self.x.truncate(n);
+        self.y.truncate(n);
+        self.p.truncate(n);
+    }
+
     /// Removes all events, keeping the allocations.
     pub fn clear(&mut self) {
         self.t.clear();

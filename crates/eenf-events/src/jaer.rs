@@ -268,6 +268,8 @@ pub struct Aedat31Reader {
     payload: Vec<u8>,
     skipped_packets: u64,
     invalid: u64,
+    /// Byte offset of the packet of the batch handed out last.
+    batch_at: u64,
 }
 
 /// Opens an AEDAT 3.1 file.
@@ -324,6 +326,7 @@ pub fn aedat31_from(mut f: Box<dyn Source>, path: &Path) -> Result<Box<dyn Event
         payload: Vec::new(),
         skipped_packets: 0,
         invalid: 0,
+        batch_at: header.data_start,
     }))
 }
 
@@ -424,9 +427,14 @@ impl EventReader for Aedat31Reader {
                 );
             }
             if !batch.is_empty() {
+                self.batch_at = at;
                 return Ok(Some(batch));
             }
         }
+    }
+
+    fn batch_offset(&self) -> Option<u64> {
+        Some(self.batch_at)
     }
 
     fn skipped(&self) -> Vec<(&'static str, u64)> {

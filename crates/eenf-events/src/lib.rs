@@ -22,6 +22,7 @@
 pub mod aedat4;
 mod batch;
 mod error;
+mod guard;
 pub mod jaer;
 pub mod prophesee;
 mod stream;
@@ -34,6 +35,7 @@ use std::path::Path;
 pub use aedat4::{Aedat4Reader, Aedat4Writer, Compression};
 pub use batch::EventBatch;
 pub use error::{EventError, Result};
+pub use guard::{Damage, DamageKind, DEFAULT_MAX_GAP_US};
 pub use text::TextReader;
 
 /// The formats this version reads, for error messages.
@@ -91,6 +93,12 @@ pub struct OpenOptions {
     pub chip: Option<String>,
     /// In a file with several cameras (a jAER stereo pair), read only this one (0, 1, …).
     pub camera: Option<u8>,
+    /// Damage and wild timestamps are errors: by default the stream ends there, with the
+    /// events before them and a [`Damage`] report.
+    pub strict: bool,
+    /// The largest step of a timestamp between two events, µs, forwards or backwards
+    /// (default [`DEFAULT_MAX_GAP_US`]); a larger one ends the stream.
+    pub max_gap_us: Option<i64>,
 }
 
 /// A source of event batches.
@@ -103,6 +111,14 @@ pub trait EventReader: Send {
     /// Words or packets read so far that were not events (triggers, IMU, APS…), by kind.
     fn skipped(&self) -> Vec<(&'static str, u64)> {
         Vec::new()
+    }
+    /// Byte offset where the data of the batch handed out last starts, when the reader knows.
+    fn batch_offset(&self) -> Option<u64> {
+        None
+    }
+    /// What ended the stream early (damage, a wild timestamp), once the stream has ended.
+    fn damage(&self) -> Option<&Damage> {
+        None
     }
 }
 
@@ -288,7 +304,12 @@ pub fn open_source_with(
             )));
         }
     }
-    Ok(reader)
+    Ok(Box::new(guard::Guarded::new(
+        reader,
+        path,
+        opts.strict,
+        opts.max_gap_us.unwrap_or(DEFAULT_MAX_GAP_US),
+    )))
 }
 
 /// Counts and ranges of a whole stream, from reading it to the end.

@@ -122,6 +122,11 @@ impl WordReader {
         })
     }
 
+    /// Ends the reading: the next chunk is `None`.
+    pub(crate) fn stop(&mut self) {
+        self.done = true;
+    }
+
     /// File offset of the first byte of the last chunk.
     pub(crate) fn chunk_offset(&self) -> u64 {
         self.chunk_offset
@@ -185,6 +190,8 @@ pub(crate) struct WordStream<D: WordDecoder> {
     format: &'static str,
     /// Added to every timestamp (eenf's `% eenf_time_offset_us` header line).
     offset: i64,
+    /// The damage found in the chunk whose events before it were handed out last.
+    failed: Option<EventError>,
 }
 
 impl<D: WordDecoder> WordStream<D> {
@@ -201,6 +208,7 @@ impl<D: WordDecoder> WordStream<D> {
             format: info.format,
             info,
             offset: 0,
+            failed: None,
         })
     }
 
@@ -216,19 +224,32 @@ impl<D: WordDecoder> EventReader for WordStream<D> {
         &self.info
     }
 
+    fn batch_offset(&self) -> Option<u64> {
+        Some(self.words.chunk_offset())
+    }
+
     fn next_batch(&mut self) -> Result<Option<EventBatch>> {
+        if let Some(e) = self.failed.take() {
+            return Err(e);
+        }
         loop {
             let Some(chunk) = self.words.next_chunk()? else {
                 return Ok(None);
             };
             let mut batch = EventBatch::with_capacity(chunk.len() / D::WORD);
             if let Err(reason) = self.decoder.decode(chunk, &mut batch) {
-                return Err(EventError::Corrupt {
+                self.words.stop();
+                let e = EventError::Corrupt {
                     path: self.words.path.clone(),
                     format: self.format,
                     offset: self.words.chunk_offset(),
                     reason,
-                });
+                };
+                // the events before the damage first, then the error
+                if batch.is_empty() {
+                    return Err(e);
+                }
+                self.failed = Some(e);
             }
             if !batch.is_empty() {
                 if self.offset != 0 {

@@ -5,7 +5,7 @@
 //! polarity 0/1 or -1/+1.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, Seek, SeekFrom};
+use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use crate::error::{io_err, EventError, Result};
@@ -13,6 +13,25 @@ use crate::{EventBatch, EventReader, Source, StreamInfo};
 
 const FORMAT: &str = "text";
 const BATCH: usize = 1 << 16;
+/// Longest line accepted: an event line is a few dozen bytes, and a line is held whole.
+const MAX_LINE: usize = 4096;
+
+/// Reads one line (with its `\n`) into `buf`, holding at most [`MAX_LINE`] + 1 bytes of it;
+/// returns the bytes consumed (0 at the end).
+fn read_line_bounded(r: &mut impl BufRead, buf: &mut Vec<u8>) -> std::io::Result<usize> {
+    buf.clear();
+    r.by_ref().take(MAX_LINE as u64 + 1).read_until(b'\n', buf)
+}
+
+/// The text of a line read by [`read_line_bounded`], or why it is not a line of text.
+fn line_text(buf: &[u8]) -> std::result::Result<&str, String> {
+    if buf.len() > MAX_LINE {
+        return Err(format!("a line longer than {MAX_LINE} bytes"));
+    }
+    std::str::from_utf8(buf)
+        .map(|l| l.trim_end_matches(['\n', '\r']))
+        .map_err(|_| "bytes that are not UTF-8 text".into())
+}
 
 /// How the time column is written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -116,7 +135,7 @@ fn parse_line(
 pub struct TextReader {
     path: PathBuf,
     lines: BufReader<Box<dyn Source>>,
-    line: String,
+    line: Vec<u8>,
     line_no: u64,
     /// Byte offset of the next line.
     offset: u64,
@@ -124,6 +143,10 @@ pub struct TextReader {
     info: StreamInfo,
     done: bool,
     seen_data: bool,
+    /// Byte offset of the first line of the batch handed out last.
+    batch_at: u64,
+    /// The damage after the batch handed out last.
+    failed: Option<EventError>,
 }
 
 impl TextReader {
@@ -139,12 +162,18 @@ impl TextReader {
     pub fn new(mut f: Box<dyn Source>, path: &Path) -> Result<Self> {
         let mut unit = TimeUnit::Micros;
         f.seek(SeekFrom::Start(0)).map_err(|e| io_err(path, e))?;
-        for line in BufReader::new(&mut f).lines().take(10_000) {
-            let line = line.map_err(|e| io_err(path, e))?;
-            if is_column_names(&line) {
+        let mut head = BufReader::new(&mut f);
+        let mut buf = Vec::new();
+        for _ in 0..10_000 {
+            if read_line_bounded(&mut head, &mut buf).map_err(|e| io_err(path, e))? == 0 {
+                break;
+            }
+            // the reading below reports a bad line where it is
+            let Ok(line) = line_text(&buf) else { break };
+            if is_column_names(line) {
                 continue;
             }
-            let first = fields(&line).map(|mut fs| fs.next().unwrap_or("").to_string());
+            let first = fields(line).map(|mut fs| fs.next().unwrap_or("").to_string());
             if let Some(t) = first {
                 if t.contains(['.', 'e', 'E']) {
                     unit = TimeUnit::Seconds;
@@ -156,7 +185,7 @@ impl TextReader {
         Ok(TextReader {
             path: path.to_path_buf(),
             lines: BufReader::with_capacity(1 << 20, f),
-            line: String::new(),
+            line: Vec::new(),
             line_no: 0,
             offset: 0,
             unit,
@@ -166,6 +195,8 @@ impl TextReader {
             },
             done: false,
             seen_data: false,
+            batch_at: 0,
+            failed: None,
         })
     }
 }
@@ -175,16 +206,21 @@ impl EventReader for TextReader {
         &self.info
     }
 
+    fn batch_offset(&self) -> Option<u64> {
+        Some(self.batch_at)
+    }
+
     fn next_batch(&mut self) -> Result<Option<EventBatch>> {
+        if let Some(e) = self.failed.take() {
+            return Err(e);
+        }
         if self.done {
             return Ok(None);
         }
+        self.batch_at = self.offset;
         let mut batch = EventBatch::with_capacity(BATCH);
         while batch.len() < BATCH {
-            self.line.clear();
-            let read = self
-                .lines
-                .read_line(&mut self.line)
+            let read = read_line_bounded(&mut self.lines, &mut self.line)
                 .map_err(|e| io_err(&self.path, e))?;
             if read == 0 {
                 self.done = true;
@@ -193,11 +229,13 @@ impl EventReader for TextReader {
             let at = self.offset;
             self.offset += read as u64;
             self.line_no += 1;
-            let line = self.line.trim_end_matches(['\n', '\r']);
-            if !self.seen_data && is_column_names(line) {
-                continue;
-            }
-            match parse_line(line, self.unit) {
+            let parsed = line_text(&self.line).and_then(|line| {
+                if !self.seen_data && is_column_names(line) {
+                    return Ok(None);
+                }
+                parse_line(line, self.unit)
+            });
+            match parsed {
                 Ok(Some((t, x, y, p))) => {
                     self.seen_data = true;
                     batch.push(t, x, y, p)
@@ -205,12 +243,18 @@ impl EventReader for TextReader {
                 Ok(None) => {}
                 Err(reason) => {
                     self.done = true;
-                    return Err(EventError::Corrupt {
+                    let e = EventError::Corrupt {
                         path: self.path.clone(),
                         format: FORMAT,
                         offset: at,
                         reason: format!("line {}: {reason}", self.line_no),
-                    });
+                    };
+                    // the events before the damage first, then the error
+                    if batch.is_empty() {
+                        return Err(e);
+                    }
+                    self.failed = Some(e);
+                    break;
                 }
             }
         }
@@ -261,7 +305,17 @@ mod tests {
             Path::new("e.txt"),
         )
         .unwrap();
+        // the events before the bad line come first, then the error
+        assert_eq!(r.next_batch().unwrap().unwrap().t, vec![10, 20]);
         let e = r.next_batch().unwrap_err().to_string();
         assert!(e.contains("at byte 26") && e.contains("line 4"), "{e}");
+        // a line without an end is held to a few KiB, never read whole
+        let mut long = b"10 1 2 1\n".to_vec();
+        long.resize(1 << 20, b'7');
+        let mut r =
+            TextReader::new(Box::new(std::io::Cursor::new(long)), Path::new("e.txt")).unwrap();
+        assert_eq!(r.next_batch().unwrap().unwrap().len(), 1);
+        let e = r.next_batch().unwrap_err().to_string();
+        assert!(e.contains("longer than 4096 bytes"), "{e}");
     }
 }

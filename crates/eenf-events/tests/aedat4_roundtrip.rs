@@ -1,6 +1,9 @@
 //! Writer → reader round trips and damaged files, on data made here (no shared files needed).
 
-use eenf_events::{open, Aedat4Writer, Compression, EventBatch, EventError, StreamStats};
+use eenf_events::{
+    open, open_with, Aedat4Writer, Compression, DamageKind, EventBatch, EventError, OpenOptions,
+    StreamStats,
+};
 use std::io::Write;
 
 fn sample(n: usize) -> EventBatch {
@@ -75,8 +78,13 @@ fn every_codec_round_trips_exactly_with_index() {
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 5);
 }
 
+/// The error `--strict` reading gives.
 fn expect_err(path: &std::path::Path) -> EventError {
-    let mut r = match open(path) {
+    let strict = OpenOptions {
+        strict: true,
+        ..OpenOptions::default()
+    };
+    let mut r = match open_with(path, &strict) {
         Ok(r) => r,
         Err(e) => return e,
     };
@@ -107,10 +115,23 @@ fn truncated_and_corrupt_files_are_errors_naming_the_file() {
     let e = expect_err(&cut);
     assert!(matches!(e, EventError::Truncated { .. }), "{e}");
     assert!(e.to_string().contains("cut.aedat4"), "{e}");
-    // the events before the damage are still delivered
+    // by default the events before the damage are read, and the damage is reported
     let mut r = open(&cut).unwrap();
-    let first = r.next_batch().unwrap().unwrap();
-    assert_eq!(first.t[..10], events.t[..10]);
+    let mut salvaged = EventBatch::default();
+    while let Some(b) = r.next_batch().unwrap() {
+        salvaged.extend_from(&b);
+    }
+    assert_eq!(salvaged.len(), 2000, "two whole packets before the cut");
+    let n = salvaged.len();
+    assert_eq!(salvaged.t[..], events.t[..n]);
+    assert_eq!(salvaged.x[..], events.x[..n]);
+    assert_eq!(salvaged.y[..], events.y[..n]);
+    assert_eq!(salvaged.p[..], events.p[..n]);
+    let d = r.damage().expect("the cut is reported");
+    assert_eq!(d.kind, DamageKind::Truncated);
+    assert_eq!(d.offset, pos as u64);
+    assert_eq!(d.events_before, 2000);
+    assert!(d.to_string().contains("the 2000 events before it"), "{d}");
 
     // flip bytes inside the compressed body of the second packet
     let bad = dir.path().join("bad.aedat4");
@@ -203,4 +224,40 @@ fn text_files_read_both_time_spellings() {
     std::fs::write(&c, "1 2 3 1\n2 2 3 1\nbroken line here\n").unwrap();
     let err = expect_err(&c);
     assert!(err.to_string().contains("line 3"), "{err}");
+}
+
+#[test]
+fn a_wild_timestamp_ends_the_stream_where_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    // one second of events, then one 48 h later, then more of the first second
+    let mut text = String::new();
+    for i in 0..1000 {
+        text += &format!("{} 1 2 1\n", i * 1000);
+    }
+    let jump_at = text.len();
+    text += &format!("{} 1 2 1\n", 48i64 * 3600 * 1_000_000);
+    text += "1000000 1 2 0\n";
+    let path = dir.path().join("jump.txt");
+    std::fs::write(&path, &text).unwrap();
+    let mut r = open(&path).unwrap();
+    let stats = StreamStats::scan(r.as_mut()).unwrap();
+    assert_eq!((stats.events, stats.last_t), (1000, Some(999_000)));
+    let d = r.damage().unwrap();
+    assert_eq!((d.kind, d.events_before), (DamageKind::TimeJump, 1000));
+    assert!(d.message.contains("172800.000000 s"), "{d}");
+    assert!(d.offset <= jump_at as u64, "{} > {jump_at}", d.offset);
+    // a wider limit reads on; --strict refuses
+    let wide = OpenOptions {
+        max_gap_us: Some(49 * 3600 * 1_000_000),
+        ..OpenOptions::default()
+    };
+    let mut r = open_with(&path, &wide).unwrap();
+    assert_eq!(StreamStats::scan(r.as_mut()).unwrap().events, 1002);
+    let e = expect_err(&path);
+    assert!(e.to_string().contains("timestamp jumps"), "{e}");
+    // backwards by more than the limit ends it too
+    std::fs::write(&path, "10000000 1 2 1\n10000010 1 2 1\n10 1 2 1\n").unwrap();
+    let mut r = open(&path).unwrap();
+    assert_eq!(StreamStats::scan(r.as_mut()).unwrap().events, 2);
+    assert_eq!(r.damage().unwrap().kind, DamageKind::TimeJump);
 }

@@ -23,6 +23,8 @@ fn read_all(path: &std::path::Path) -> EventBatch {
     while let Some(b) = r.next_batch().unwrap_or_else(|e| panic!("{e}")) {
         all.extend_from(&b);
     }
+    // read to its end: nothing cut short as damage or a wild timestamp
+    assert_eq!(r.damage(), None, "{}", path.display());
     all
 }
 

@@ -84,6 +84,8 @@ pub struct Sampled {
     pub camera: Option<u8>,
     /// What had to be decided on the way (camera, chip), for the user.
     pub notes: Vec<String>,
+    /// What ended the stream before the file's end (damage, a wild timestamp).
+    pub damage: Option<eenf_events::Damage>,
 }
 
 /// Reads `path` (as `open` says) into a flicker signal sampled with `sampling` every `dt_us`.
@@ -127,8 +129,12 @@ fn sample_reader(
         bar.inc(batch.len() as u64);
     }
     bar.finish_and_clear();
+    let damage = reader.damage().cloned();
     if events == 0 {
-        bail!("{}: the event stream is empty", path.display());
+        match damage {
+            Some(d) => bail!("{}", d.message),
+            None => bail!("{}: the event stream is empty", path.display()),
+        }
     }
     let seq = sampler
         .finish()
@@ -141,6 +147,7 @@ fn sample_reader(
         info,
         events,
         seq,
+        damage,
     })
 }
 
@@ -369,6 +376,7 @@ pub fn extract_sampled(
         camera: s.camera,
         flicker: line,
         notes,
+        damage: s.damage.map(|d| d.to_string()),
     };
     Ok(Trace::from_events(path, &estimates, provenance))
 }

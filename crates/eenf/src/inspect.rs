@@ -34,6 +34,8 @@ pub struct Inspection {
     pub grouping: Option<Grouping>,
     /// The flicker line of each camera.
     pub flicker: Vec<CameraFlicker>,
+    /// What ended the readable part before the file's end (damage, a wild timestamp).
+    pub damage: Option<eenf_events::Damage>,
 }
 
 /// Reads `path` (as `open` says) to the end: its statistics, and the flicker line (1 ms
@@ -55,6 +57,7 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
         wild = wild || sampler.push(&b).is_err() || auto.push(&b).is_err();
     }
     let skipped = reader.skipped();
+    let damage = reader.damage().cloned();
     let line_of = |sampler: TemporalSampler| {
         let seq = sampler.finish().ok()?;
         flicker_line(&seq.signal(), seq.fs())
@@ -83,5 +86,6 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
         skipped,
         grouping,
         flicker,
+        damage,
     })
 }

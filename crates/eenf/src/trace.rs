@@ -68,6 +68,9 @@ pub struct EventsProvenance {
     /// What was inferred or adapted on the way (chip, camera, window, clock).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// What ended the readable part of a damaged or cut-short recording early, and where.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damage: Option<String>,
 }
 
 /// Marks a V-ENF trace in JSON (`"method": "v-enf"`).

@@ -256,7 +256,10 @@ pub struct Aedat4Reader {
     /// Stream ids whose packets may hold events (from the XML; empty = check every packet).
     event_streams: Vec<i32>,
     info: StreamInfo,
-    pending: VecDeque<EventBatch>,
+    /// Decoded batches, each with the byte offset of its packet.
+    pending: VecDeque<(u64, EventBatch)>,
+    /// Byte offset of the packet of the batch handed out last.
+    batch_at: Option<u64>,
     failed: Option<EventError>,
     /// Packets read and waiting to be decoded (the first `ready` slots).
     current: Vec<Slot>,
@@ -369,6 +372,7 @@ impl Aedat4Reader {
             event_streams,
             info,
             pending: VecDeque::new(),
+            batch_at: None,
             failed: None,
             current: Vec::new(),
             ready: 0,
@@ -445,13 +449,13 @@ impl Aedat4Reader {
         let mut next = std::mem::take(&mut self.next);
         let more = self.read_error.is_none() && self.pos < self.end;
         let (decoded, (n_next, err_next)) = rayon::join(
-            || -> Vec<std::result::Result<Option<EventBatch>, (u64, String)>> {
+            || -> Vec<(u64, std::result::Result<Option<EventBatch>, String>)> {
                 current[..ready]
                     .par_iter()
                     .map_init(Vec::new, |scratch, slot| {
-                        decompress(codec, &slot.body[..slot.size], scratch)
-                            .and_then(decode_event_packet)
-                            .map_err(|e| (slot.at, e))
+                        let batch = decompress(codec, &slot.body[..slot.size], scratch)
+                            .and_then(decode_event_packet);
+                        (slot.at, batch)
                     })
                     .collect()
             },
@@ -468,11 +472,11 @@ impl Aedat4Reader {
         self.current = next;
         self.ready = n_next;
         let read_error = std::mem::replace(&mut self.read_error, err_next);
-        for d in decoded {
+        for (at, d) in decoded {
             match d {
-                Ok(Some(b)) if !b.is_empty() => self.pending.push_back(b),
+                Ok(Some(b)) if !b.is_empty() => self.pending.push_back((at, b)),
                 Ok(_) => {}
-                Err((at, reason)) => {
+                Err(reason) => {
                     // deliver the events before the damage, then the error
                     self.failed = Some(self.corrupt(at, reason));
                     self.ready = 0;
@@ -564,9 +568,14 @@ impl EventReader for Aedat4Reader {
         &self.info
     }
 
+    fn batch_offset(&self) -> Option<u64> {
+        self.batch_at
+    }
+
     fn next_batch(&mut self) -> Result<Option<EventBatch>> {
         loop {
-            if let Some(b) = self.pending.pop_front() {
+            if let Some((at, b)) = self.pending.pop_front() {
+                self.batch_at = Some(at);
                 return Ok(Some(b));
             }
             if let Some(e) = self.failed.take() {

@@ -108,6 +108,14 @@ pub struct InputArgs {
     /// `extract` takes the one whose flicker stands highest; `info` and `convert` read all.
     #[arg(long)]
     pub camera: Option<u8>,
+    /// Refuse a damaged or cut-short file, or one whose time jumps by more than --max-gap.
+    /// Default: read the events before the damage, with a warning that says where it is.
+    #[arg(long)]
+    pub strict: bool,
+    /// The largest step of the event time between two events, seconds, forwards or
+    /// backwards: a larger one (a corrupt timestamp) ends the usable stream there.
+    #[arg(long, default_value_t = eenf_events::DEFAULT_MAX_GAP_US as f64 * 1e-6)]
+    pub max_gap: f64,
 }
 
 impl InputArgs {
@@ -116,6 +124,9 @@ impl InputArgs {
         eenf_events::OpenOptions {
             chip: self.chip.clone(),
             camera: self.camera,
+            strict: self.strict,
+            // NaN and negatives: no step is allowed; huge values: any is
+            max_gap_us: Some((self.max_gap * 1e6).clamp(0.0, i64::MAX as f64) as i64),
         }
     }
 }

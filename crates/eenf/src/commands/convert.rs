@@ -52,6 +52,9 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         Ok(())
     })?;
     bar.finish_and_clear();
+    if let Some(d) = reader.damage() {
+        eprintln!("warning: {d}");
+    }
     let took = started.elapsed().as_secs_f64();
     eprintln!(
         "{} ({}) -> {} ({format}): {n} events, {width}x{height}, in {took:.2} s ({:.1} M events/s)",

@@ -41,6 +41,9 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         for n in &x.notes {
             eprintln!("note: {n}");
         }
+        if let Some(d) = &x.damage {
+            eprintln!("warning: {d}");
+        }
         eprintln!(
             "{}: {} events, {:.1} s, {} Hz grid{}, {} sampling, {} estimates (mean {:.4} Hz) in {took:.2} s ({:.1} M events/s)",
             a.file.display(),

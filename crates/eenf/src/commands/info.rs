@@ -87,6 +87,9 @@ pub fn run(a: Args) -> Result<()> {
             "cameras": info.cameras, "notes": info.notes,
             "sampling": sampling.as_ref().map(|s| serde_json::json!({"auto": s.0, "why": s.1})),
             "flicker": found.flicker,
+            "damage": found.damage.as_ref().map(|d| serde_json::json!({
+                "kind": d.kind.to_string(), "offset": d.offset,
+                "events_before": d.events_before, "message": d.message})),
         });
         outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
@@ -134,6 +137,15 @@ pub fn run(a: Args) -> Result<()> {
     }
     for n in &info.notes {
         outln!("note        {n}");
+    }
+    if let Some(d) = &found.damage {
+        outln!(
+            "damage      {} at byte {}: the {} events before it are counted above",
+            d.kind,
+            d.offset,
+            d.events_before
+        );
+        eprintln!("warning: {d}");
     }
     Ok(())
 }
