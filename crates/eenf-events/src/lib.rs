@@ -152,10 +152,88 @@ pub struct Probed {
     header: Option<stream::TextHeader>,
 }
 
-/// Decides the format of the file at `path` from its first bytes.
+/// Decides the format of the file at `path` from its first bytes (`-`: stdin).
 pub fn probe(path: &Path) -> Result<Format> {
-    let mut f = std::fs::File::open(path).map_err(|e| error::io_err(path, e))?;
-    Ok(probe_source(&mut f, path)?.format)
+    let mut f = open_file(path)?;
+    Ok(probe_source(f.as_mut(), path)?.format)
+}
+
+/// Opens `path` for reading as a seekable byte stream; `-` is stdin. What cannot seek (a pipe,
+/// a FIFO, a terminal) is first copied into an unnamed temporary file (on disk: memory stays
+/// flat), once per name: every later open of the same name reads that copy again, so every
+/// format, and every command that reads a file twice, works from a pipe.
+pub fn open_file(path: &Path) -> Result<Box<dyn Source>> {
+    use std::collections::HashMap;
+    use std::sync::Mutex;
+    static SPOOLED: Mutex<Option<HashMap<std::path::PathBuf, std::fs::File>>> = Mutex::new(None);
+    let io = |e| error::io_err(path, e);
+    let stdin = path.as_os_str() == "-";
+    let file = if stdin {
+        None
+    } else {
+        let f = std::fs::File::open(path).map_err(io)?;
+        if f.metadata().map_err(io)?.is_file() {
+            return Ok(Box::new(f));
+        }
+        Some(f)
+    };
+    let mut cache = SPOOLED.lock().unwrap_or_else(|p| p.into_inner());
+    let cache = cache.get_or_insert_with(HashMap::new);
+    if !cache.contains_key(path) {
+        let mut spool = tempfile_in_tmp().map_err(io)?;
+        match file {
+            Some(mut f) => std::io::copy(&mut f, &mut spool),
+            None => std::io::copy(&mut std::io::stdin().lock(), &mut spool),
+        }
+        .map_err(io)?;
+        cache.insert(path.to_path_buf(), spool);
+    }
+    reopen(&cache[path]).map_err(io)
+}
+
+/// An unnamed file in the temporary folder, gone when closed.
+fn tempfile_in_tmp() -> std::io::Result<std::fs::File> {
+    let dir = std::env::temp_dir();
+    #[cfg(all(target_os = "linux", target_arch = "x86_64"))]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // O_TMPFILE (x86-64 value): never has a name, so nothing is left behind, whatever ends the program
+        const O_TMPFILE: i32 = 0o20000000 | 0o200000;
+        if let Ok(f) = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .custom_flags(O_TMPFILE)
+            .mode(0o600)
+            .open(&dir)
+        {
+            return Ok(f);
+        }
+    }
+    // elsewhere: a named file, removed at once (the open handle keeps it)
+    let path = dir.join(format!(".eenf-stdin.{}", std::process::id()));
+    let f = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create_new(true)
+        .open(&path)?;
+    let _ = std::fs::remove_file(&path);
+    Ok(f)
+}
+
+/// A handle on `f` with its own offset (Linux: through `/proc/self/fd`), so that readers opened
+/// one after another do not move each other; else a clone sharing the offset (readers seek to
+/// where they read).
+fn reopen(f: &std::fs::File) -> std::io::Result<Box<dyn Source>> {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::fd::AsRawFd;
+        if let Ok(g) = std::fs::File::open(format!("/proc/self/fd/{}", f.as_raw_fd())) {
+            return Ok(Box::new(g));
+        }
+    }
+    let mut g = f.try_clone()?;
+    g.seek(SeekFrom::Start(0))?;
+    Ok(Box::new(g))
 }
 
 /// Decides the format of `src` (named `path` in errors) from its first bytes; leaves `src`
@@ -249,15 +327,15 @@ pub fn probe_source(src: &mut dyn Source, path: &Path) -> Result<Probed> {
     )))
 }
 
-/// Opens an event file with the reader its content calls for.
+/// Opens an event file (`-`: stdin) with the reader its content calls for.
 pub fn open(path: &Path) -> Result<Box<dyn EventReader>> {
     open_with(path, &OpenOptions::default())
 }
 
 /// Opens an event file as `opts` say.
 pub fn open_with(path: &Path, opts: &OpenOptions) -> Result<Box<dyn EventReader>> {
-    let f = std::fs::File::open(path).map_err(|e| error::io_err(path, e))?;
-    open_source_with(Box::new(f), path, opts)
+    let f = open_file(path)?;
+    open_source_with(f, path, opts)
 }
 
 /// The reader that the content of `src` (named `path` in errors) calls for. The head is read

@@ -347,6 +347,21 @@ pub fn relative(base: &Path, path: &Path) -> String {
         .replace('\\', "/")
 }
 
+/// The file `simulate-dataset` keeps in a dataset folder while it builds it: a folder that
+/// holds it was left half-built (the run was killed) and is not scored.
+pub const BUILDING_MARKER: &str = ".eenf-building";
+
+/// Refuses a dataset folder that `simulate-dataset` did not finish building.
+pub fn check_complete(dir: &Path) -> Result<()> {
+    if dir.join(BUILDING_MARKER).exists() {
+        bail!(
+            "{}: simulate-dataset did not finish building this dataset (it holds {BUILDING_MARKER}); build it again",
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

@@ -60,6 +60,9 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(e) = eenf::output::clean_up_on_signals() {
+        eprintln!("eenf: warning: {e:#}");
+    }
     let progress = eenf::progress::Progress::new(cli.quiet);
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),

@@ -1,15 +1,72 @@
 //! Output files, written whole or not at all: every file eenf writes goes through
 //! [`AtomicFile`]. A regular target gets a temporary file beside it, renamed over it when
-//! complete; a symlink's real file is the target (the link stays); a device or FIFO is written
-//! into (renaming over `/dev/null` would replace the device), from a temporary copy so that it
-//! too gets the whole output or nothing.
+//! complete; a symlink's real file is the target (the link stays); a device, a FIFO or `-`
+//! (stdout) is written into (renaming over `/dev/null` would replace the device), from a
+//! temporary copy so that it too gets the whole output or nothing. Missing parent folders are
+//! created. Temporary files (and folders being built) are removed on errors and, after
+//! [`clean_up_on_signals`], when the program is interrupted.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use tempfile::NamedTempFile;
+
+/// Temporary files and folders being written, removed if a signal ends the program.
+static IN_PROGRESS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Marks `path` as temporary until [`forget_in_progress`]: an interrupt removes it.
+pub fn register_in_progress(path: &Path) {
+    if let Ok(mut v) = IN_PROGRESS.lock() {
+        v.push(path.to_path_buf());
+    }
+}
+
+/// `path` is no longer temporary (renamed into place, or removed).
+pub fn forget_in_progress(path: &Path) {
+    if let Ok(mut v) = IN_PROGRESS.lock() {
+        v.retain(|p| p != path);
+    }
+}
+
+/// On SIGINT, SIGTERM or SIGHUP: removes every temporary file and folder in progress, then
+/// ends the program with the usual status (128 + the signal). Call once, early in `main`.
+pub fn clean_up_on_signals() -> Result<()> {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
+        .context("cannot install the signal handlers")?;
+    std::thread::spawn(move || {
+        if let Some(sig) = signals.forever().next() {
+            // the lock is held only for short pushes and removals: waiting for it is brief
+            let paths = IN_PROGRESS.lock().map(|v| v.clone()).unwrap_or_default();
+            for p in paths.iter().rev() {
+                if p.is_dir() {
+                    let _ = std::fs::remove_dir_all(p);
+                } else {
+                    let _ = std::fs::remove_file(p);
+                }
+            }
+            std::process::exit(128 + sig);
+        }
+    });
+    Ok(())
+}
+
+/// True when `path` names stdout (`-`).
+pub fn is_stdout(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// Creates the missing parent folders of the output `path`.
+pub fn create_parent(path: &Path) -> Result<()> {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() && !d.exists() => std::fs::create_dir_all(d)
+            .with_context(|| format!("{}: cannot create the folder", d.display())),
+        _ => Ok(()),
+    }
+}
 
 /// True when `path` exists and is not a regular file or folder (a device, a FIFO).
 pub fn is_special_file(path: &Path) -> bool {
@@ -23,6 +80,24 @@ pub struct AtomicFile {
     target: PathBuf,
     tmp: NamedTempFile,
     special: bool,
+    _in_progress: InProgress,
+}
+
+/// A path removed on interrupts for as long as this lives (see [`register_in_progress`]).
+pub struct InProgress(PathBuf);
+
+impl InProgress {
+    /// Registers `path`.
+    pub fn new(path: &Path) -> Self {
+        register_in_progress(path);
+        InProgress(path.to_path_buf())
+    }
+}
+
+impl Drop for InProgress {
+    fn drop(&mut self) {
+        forget_in_progress(&self.0);
+    }
 }
 
 impl AtomicFile {
@@ -46,7 +121,13 @@ impl AtomicFile {
             }
             _ => path.to_path_buf(),
         };
-        let special = is_special_file(&target);
+        if target.is_dir() {
+            bail!("{}: is a folder, not a file", path.display());
+        }
+        let special = is_stdout(path) || is_special_file(&target);
+        if !special {
+            create_parent(&target)?;
+        }
         let dir = match target.parent() {
             _ if special => std::env::temp_dir(),
             Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
@@ -63,6 +144,7 @@ impl AtomicFile {
             .with_context(|| format!("{}: cannot create a temporary file", path.display()))?;
         Ok(AtomicFile {
             target,
+            _in_progress: InProgress::new(tmp.path()),
             tmp,
             special,
         })
@@ -90,9 +172,15 @@ impl AtomicFile {
                 target.display()
             )
         };
-        self.tmp.as_file().sync_all().with_context(what)?;
         if self.special {
             let mut src = self.tmp.reopen().with_context(what)?;
+            if is_stdout(&target) {
+                let mut out = std::io::stdout().lock();
+                // the io::Error stays in the chain: a closed pipe ends the program quietly
+                std::io::copy(&mut src, &mut out).context("stdout")?;
+                out.flush().context("stdout")?;
+                return Ok(());
+            }
             let mut dst = std::fs::OpenOptions::new()
                 .write(true)
                 .open(&target)
@@ -100,6 +188,7 @@ impl AtomicFile {
             std::io::copy(&mut src, &mut dst).with_context(what)?;
             return Ok(());
         }
+        self.tmp.as_file().sync_all().with_context(what)?;
         self.tmp
             .persist(&target)
             .map_err(|e| e.error)

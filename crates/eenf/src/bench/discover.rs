@@ -101,8 +101,11 @@ fn has_extension(p: &Path, list: &[&str]) -> bool {
 /// `ENF_Reference/` with hourly WAVs).
 pub fn discover(dataset: &Path) -> Result<Vec<Recording>> {
     if dataset.is_dir() {
+        crate::dataset::check_complete(dataset)?;
         scan_tree(dataset)
     } else if dataset.is_file() {
+        let folder = dataset.parent().filter(|d| !d.as_os_str().is_empty());
+        crate::dataset::check_complete(folder.unwrap_or(Path::new(".")))?;
         read_manifest(dataset)
     } else {
         bail!("{}: no such dataset folder or manifest", dataset.display())

@@ -270,8 +270,10 @@ impl TraceOutputArgs {
 
     /// Says where the trace went (stderr).
     pub fn report(&self) {
-        if let Some(out) = &self.output {
-            eprintln!("trace written to {}", out.display());
+        match &self.output {
+            Some(out) if eenf::output::is_stdout(out) => {}
+            Some(out) => eprintln!("trace written to {}", out.display()),
+            None => {}
         }
     }
 }

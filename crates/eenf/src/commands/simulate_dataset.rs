@@ -5,8 +5,9 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use eenf::dataset::{
     plan_dataset, recording_name, reference_name, relative, scored_against_truth, DatasetSpec,
+    PlannedRecording, BUILDING_MARKER,
 };
-use eenf::output::write_atomic;
+use eenf::output::{write_atomic, InProgress};
 use eenf::progress::Progress;
 use eenf::simulation::{write_recording, write_video, EnfTimeline};
 use eenf::time::{tz_offset, LocalTime};
@@ -92,7 +93,6 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     };
     let codec = a.compression;
     let cameras = a.video.cameras()?;
-    let tz = spec.tz_s;
     let timeline = match &a.enf_dir {
         Some(dir) => EnfTimeline::wav_dir(dir)?,
         None => {
@@ -104,9 +104,46 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         }
     };
     let (plans, duration) = plan_dataset(&spec, timeline.coverage()?)?;
-    let (width, height) = (plans[0].config.width, plans[0].config.height);
 
+    // a folder made here is removed if the run fails or is interrupted; one that existed is
+    // marked as being built until the manifest is written, so that a half-built tree is
+    // never scored
+    let made = (!a.out_dir.exists()).then(|| InProgress::new(&a.out_dir));
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("{}", a.out_dir.display()))?;
+    let marker = a.out_dir.join(BUILDING_MARKER);
+    std::fs::write(&marker, "simulate-dataset is building this folder\n")
+        .with_context(|| format!("{}", marker.display()))?;
+    for done in ["manifest.csv", "dataset.json"] {
+        let _ = std::fs::remove_file(a.out_dir.join(done));
+    }
+    let built = build(
+        &a, &spec, &timeline, &plans, duration, &cameras, codec, &progress,
+    );
+    if built.is_err() {
+        if made.is_some() {
+            let _ = std::fs::remove_dir_all(&a.out_dir);
+        }
+        return built;
+    }
+    std::fs::remove_file(&marker).with_context(|| format!("{}", marker.display()))?;
+    drop(made);
+    Ok(())
+}
+
+/// Writes the dataset's recordings, references, manifest and summary into `a.out_dir`.
+#[allow(clippy::too_many_arguments)]
+fn build(
+    a: &Args,
+    spec: &DatasetSpec,
+    timeline: &EnfTimeline,
+    plans: &[PlannedRecording],
+    duration: f64,
+    cameras: &[eenf_sim::CameraConfig],
+    codec: Compression,
+    progress: &Progress,
+) -> Result<()> {
+    let tz = spec.tz_s;
+    let (width, height) = (plans[0].config.width, plans[0].config.height);
     let ref_dir = a.out_dir.join("ENF_Reference");
     let last_end = plans
         .iter()
@@ -127,7 +164,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let started = std::time::Instant::now();
     let mut rows = Vec::new();
     let mut total_events = 0u64;
-    for plan in &plans {
+    for plan in plans {
         let dir = a.out_dir.join(plan.class);
         std::fs::create_dir_all(&dir).with_context(|| format!("{}", dir.display()))?;
         let t = LocalTime::from_local_seconds(plan.local_start);
@@ -161,7 +198,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             )
         };
         let mut videos = Vec::new();
-        for camera in &cameras {
+        for camera in cameras {
             let hidden = Progress::hidden();
             for v in write_video(&plan.config, camera, &mains, &path, a.video.mp4, &hidden)? {
                 videos.push(relative(&a.out_dir, &v));
