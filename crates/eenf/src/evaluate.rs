@@ -27,16 +27,28 @@ pub enum Reference {
     },
     /// One mains WAV, traced whole; the estimate's time 0 is at `offset_s` into it.
     Wav(PathBuf),
-    /// A trace CSV/JSON in the reference's own time.
-    Trace(PathBuf),
+    /// A trace CSV/JSON in the reference's own time; an `index,value` CSV has a value every
+    /// `index_step_s` seconds.
+    Trace {
+        /// The file.
+        path: PathBuf,
+        /// Seconds between the rows of an `index,value` CSV.
+        index_step_s: f64,
+    },
 }
 
 impl Reference {
     /// The reference `path` for a recording named `recording` (whose `dvSave-…` name gives its
-    /// start when `path` is a folder), and the offset left to add to the estimate's times.
-    /// `offset_s` (whole seconds into an hourly WAV) turns that WAV into the folder form, so
-    /// that a recording running past the hour continues in the next file.
-    pub fn resolve(path: &Path, recording: &Path, offset_s: f64) -> Result<(Reference, f64)> {
+    /// start when `path` is a folder or one hourly WAV and no offset is given), and the offset
+    /// left to add to the estimate's times. `offset_s` (whole seconds into an hourly WAV) turns
+    /// that WAV into the folder form, so that a recording running past the hour continues in
+    /// the next file. An `index,value` trace CSV has a value every `index_step_s` seconds.
+    pub fn resolve(
+        path: &Path,
+        recording: &Path,
+        offset_s: f64,
+        index_step_s: f64,
+    ) -> Result<(Reference, f64)> {
         if path.is_dir() {
             let start = recording_start(recording).with_context(|| {
                 format!(
@@ -53,8 +65,47 @@ impl Reference {
             ));
         }
         if !is_wav(path) {
-            return Ok((Reference::Trace(path.to_path_buf()), offset_s));
+            let reference = Reference::Trace {
+                path: path.to_path_buf(),
+                index_step_s,
+            };
+            return Ok((reference, offset_s));
         }
+        let folder = || {
+            path.parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(Path::new("."))
+                .to_path_buf()
+        };
+        match (reference_hour(path), recording_start(recording)) {
+            // an hourly WAV, no offset given, and a recording whose name says when it started:
+            // placed by its name, as in a folder (the next hour's file is read if it runs on)
+            (Some(hour), Some(start)) if offset_s == 0.0 => {
+                if start.hour_index() != hour.hour_index() {
+                    bail!(
+                        "{}: the recording {} starts at {} {:02}:{:02}:{:02}, outside this hour's reference (pass the folder of hourly WAVs, or --offset-s)",
+                        path.display(),
+                        recording.display(),
+                        start.date(),
+                        start.hour(),
+                        start.second_of_hour() / 60,
+                        start.second_of_hour() % 60
+                    );
+                }
+                Ok((
+                    Reference::Hourly {
+                        dir: folder(),
+                        start,
+                    },
+                    0.0,
+                ))
+            }
+            _ => Self::resolve_wav(path, offset_s),
+        }
+    }
+
+    /// One WAV with an explicit offset: an hourly one becomes the folder form from that second.
+    fn resolve_wav(path: &Path, offset_s: f64) -> Result<(Reference, f64)> {
         match reference_hour(path) {
             // an hourly WAV and whole seconds into it: the folder form, from that second
             Some(hour) if offset_s >= 0.0 && offset_s.fract() == 0.0 => {
@@ -111,9 +162,9 @@ pub fn compare(
             reference_for_recording(dir, *start, seconds, nominal, params)?
         }
         Reference::Wav(path) => reference_file(path, nominal, params)?,
-        Reference::Trace(path) => Trace {
+        Reference::Trace { path, index_step_s } => Trace {
             nominal_hz: None,
-            ..Trace::read(path, None)?
+            ..Trace::read(path, Some(*index_step_s))?
         },
     };
     let (t, e, ref_v) = align(time_s, enf_hz, &r.time_s, &r.enf_hz, offset_s);
@@ -140,6 +191,7 @@ pub fn compare_trace(
     estimate_path: &Path,
     reference: &Path,
     offset_s: f64,
+    index_step_s: f64,
     nominal: Nominal,
     params: &EnfParams,
 ) -> Result<Comparison> {
@@ -152,7 +204,7 @@ pub fn compare_trace(
     } else {
         estimate_path.to_path_buf()
     };
-    let (reference, offset) = Reference::resolve(reference, &named, offset_s)?;
+    let (reference, offset) = Reference::resolve(reference, &named, offset_s, index_step_s)?;
     compare(
         &estimate.time_s,
         &estimate.enf_hz,

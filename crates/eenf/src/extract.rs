@@ -261,7 +261,12 @@ fn tile_mask(
 /// E-ENF from an event file.
 pub fn extract_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> Result<Trace> {
     let s = sample_file(path, opts, progress)?;
-    extract_sampled(path, s, opts, progress)
+    // when what was left before the damage is not enough, the error says why so little was read
+    let damage = s.damage.as_ref().map(|d| d.message.clone());
+    extract_sampled(path, s, opts, progress).map_err(|e| match damage {
+        Some(d) => anyhow::anyhow!("{e:#} (only the events before the damage were read: {d})"),
+        None => e,
+    })
 }
 
 /// The grid of a flicker signal: decided from its strongest line near 100/120 Hz, or checked

@@ -10,6 +10,10 @@ use eenf_dsp::{EnfEstimates, EnfParams, FlickerLine, PeakMethod, SamplingMethod}
 use eenf_video::{RowSampling, SceneRemoval, VideoAnalysis, VideoOptions};
 use serde::{Deserialize, Serialize};
 
+/// Seconds between the rows of an `index,value` trace CSV unless told otherwise: the step of
+/// the published 60 Hz ENF traces and of `simulate --enf-step`.
+pub const INDEX_STEP_S: f64 = 2.0;
+
 /// The CSV header of trace files; checks outside the code rely on these first two columns.
 pub const CSV_HEADER: &str = "time_s,enf_hz";
 
@@ -445,9 +449,13 @@ impl Trace {
         if trimmed.starts_with('{') {
             return Self::parse_json(trimmed, path);
         }
+        // `index,value` rows: without a header (the published ENF traces) or under that one
         let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
+        let first = header.split(',').next().unwrap_or("").trim();
+        let index_rows =
+            first.parse::<f64>().is_ok() || header.replace(' ', "") == "index,value";
         match index_step_s {
-            Some(step) if !header.contains("time_s") => Self::parse_index_csv(text, path, step),
+            Some(step) if index_rows => Self::parse_index_csv(text, path, step),
             _ => Self::parse_csv(text, path),
         }
     }

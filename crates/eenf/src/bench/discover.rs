@@ -100,12 +100,16 @@ fn has_extension(p: &Path, list: &[&str]) -> bool {
 /// folder per class holding event files and their `<stem>_lr.*`/`<stem>_hr.*` videos, and
 /// `ENF_Reference/` with hourly WAVs).
 pub fn discover(dataset: &Path) -> Result<Vec<Recording>> {
+    // a tree simulate-dataset left half-built is refused, whether named by folder or manifest
+    let folder = match dataset.parent().filter(|d| !d.as_os_str().is_empty()) {
+        _ if dataset.is_dir() => dataset,
+        Some(parent) => parent,
+        None => Path::new("."),
+    };
+    crate::dataset::check_complete(folder)?;
     if dataset.is_dir() {
-        crate::dataset::check_complete(dataset)?;
         scan_tree(dataset)
     } else if dataset.is_file() {
-        let folder = dataset.parent().filter(|d| !d.as_os_str().is_empty());
-        crate::dataset::check_complete(folder.unwrap_or(Path::new(".")))?;
         read_manifest(dataset)
     } else {
         bail!("{}: no such dataset folder or manifest", dataset.display())

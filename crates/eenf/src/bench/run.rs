@@ -120,7 +120,12 @@ fn run_method(rec: &Recording, method: Method, s: &Settings, spectrum: bool) -> 
         ..eenf_dsp::EnfParams::default()
     };
     let source = t.file.clone().unwrap_or_else(|| rec.path.clone());
-    let (reference, offset) = Reference::resolve(&rec.reference, &rec.path, rec.offset_s)?;
+    let (reference, offset) = Reference::resolve(
+        &rec.reference,
+        &rec.path,
+        rec.offset_s,
+        crate::trace::INDEX_STEP_S,
+    )?;
     let comparison = compare(
         &t.time_s,
         &t.enf_hz,

@@ -21,9 +21,14 @@ pub struct Args {
     /// `2022_08_17_Wed_16_00_00.wav` (the estimate's recording name `dvSave-…` then gives the
     /// offset).
     pub reference: PathBuf,
-    /// Seconds to add to the estimate's times to reach the reference's times.
+    /// Seconds to add to the estimate's times to reach the reference's times. Against one
+    /// hourly WAV or a folder of them, the default places the recording by its `dvSave-…` name.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub offset_s: f64,
+    /// Seconds between the rows of an `index,value` CSV (estimate or reference), such as the
+    /// published 60 Hz ENF traces.
+    #[arg(long, default_value_t = eenf::trace::INDEX_STEP_S)]
+    pub index_step: f64,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -39,7 +44,10 @@ pub struct Args {
 }
 
 pub fn run(a: Args, progress: Progress) -> Result<()> {
-    let est = Trace::read(&a.estimate, None)?;
+    if a.index_step.is_nan() || a.index_step <= 0.0 {
+        anyhow::bail!("--index-step must be positive");
+    }
+    let est = Trace::read(&a.estimate, Some(a.index_step))?;
     let params = EnfParams {
         peak: a.peak.or_else(|| est.peak()).unwrap_or(PeakMethod::Exact),
         ..EnfParams::default()
@@ -50,6 +58,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         &a.estimate,
         &a.reference,
         a.offset_s,
+        a.index_step,
         a.nominal,
         &params,
     )?;

@@ -81,6 +81,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         &trace_csv,
         &sim.truth,
         0.0,
+        eenf::trace::INDEX_STEP_S,
         Nominal::Hz(50.0),
         &EnfParams::default(),
     )?;
