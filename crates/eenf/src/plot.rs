@@ -19,8 +19,8 @@ const PALETTE: [RGBColor; 6] = [
     RGBColor(227, 119, 194),
 ];
 
-fn e<T: std::fmt::Debug>(err: T) -> anyhow::Error {
-    anyhow!("drawing failed: {err:?}")
+fn e<T: std::fmt::Display>(err: T) -> anyhow::Error {
+    anyhow!("drawing failed: {err}")
 }
 
 /// Registers the bundled font as plotters' `sans-serif` (once per process).

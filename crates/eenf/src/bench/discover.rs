@@ -131,6 +131,12 @@ pub fn class_rank(class: &str) -> (usize, String) {
     )
 }
 
+/// A name starting with a dot.
+fn is_hidden(p: &Path) -> bool {
+    p.file_name()
+        .is_some_and(|n| n.to_string_lossy().starts_with('.'))
+}
+
 fn scan_tree(dir: &Path) -> Result<Vec<Recording>> {
     let references = dir.join("ENF_Reference");
     if !references.is_dir() {
@@ -144,12 +150,7 @@ fn scan_tree(dir: &Path) -> Result<Vec<Recording>> {
         .with_context(|| format!("{}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.is_dir() && p.file_name() != Some("ENF_Reference".as_ref()))
-        .filter(|p| {
-            !p.file_name()
-                .unwrap_or_default()
-                .to_string_lossy()
-                .starts_with('.')
-        })
+        .filter(|p| !is_hidden(p))
         .collect();
     classes.sort();
     for class_dir in classes {
@@ -157,7 +158,8 @@ fn scan_tree(dir: &Path) -> Result<Vec<Recording>> {
         let mut files: Vec<PathBuf> = std::fs::read_dir(&class_dir)
             .with_context(|| format!("{}", class_dir.display()))?
             .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.is_file())
+            // hidden names are temporary files of a run in progress or killed, never recordings
+            .filter(|p| p.is_file() && !is_hidden(p))
             .collect();
         files.sort();
         for f in files.iter().filter(|f| has_extension(f, &EVENT_EXTENSIONS)) {

@@ -1,0 +1,140 @@
+#!/usr/bin/env python3
+"""Hostile-input sweep: every fixture cut at every 1/200th of its length and copied with random
+bit flips, each copy run through `info`, `extract` and a fine `extract` under a 2 GB
+address-space limit (as `ulimit -v 2000000`). Bad input may give an error, never a panic, an
+abort, a hang (20 s) or more than 200 MB of memory.
+
+    tools/sweep.py EENF_BINARY FIXTURES_DIR [--flips 300] [--cuts 200] [--jobs 2]
+
+Prints the counts and exits non-zero on any panic, abort, timeout or memory overrun. Each
+child's peak memory is its own (wait4), not the sweep's.
+"""
+import argparse
+import os
+import random
+import resource
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+LIMIT_AS = 2_000_000 * 1024  # ulimit -v 2000000 (KiB)
+TIMEOUT_S = 20
+MAX_RSS_MB = 200
+COMMANDS = {
+    "info": ["info"],
+    "extract": ["extract"],
+    "extract-fine": ["extract", "--window", "0.02", "--step", "0.01", "--dt-us", "100"],
+}
+
+
+def limit():
+    resource.setrlimit(resource.RLIMIT_AS, (LIMIT_AS, LIMIT_AS))
+
+
+def run(binary, cmd, path, errdir):
+    """Runs one command; returns (outcome, peak_mb, detail)."""
+    with tempfile.TemporaryFile(dir=errdir) as err:
+        p = subprocess.Popen(
+            [binary, "--quiet", *COMMANDS[cmd], path],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=err,
+            preexec_fn=limit,
+        )
+        timer = threading.Timer(TIMEOUT_S, p.kill)
+        timer.start()
+        t0 = time.monotonic()
+        _, status, usage = os.wait4(p.pid, 0)
+        took = time.monotonic() - t0
+        timer.cancel()
+        p.returncode = 0  # reaped here, not by Popen
+        err.seek(0)
+        text = err.read().decode("utf-8", "replace")
+    peak_mb = usage.ru_maxrss / 1024
+    if os.WIFSIGNALED(status):
+        sig = os.WTERMSIG(status)
+        if sig == signal.SIGKILL and took >= TIMEOUT_S - 0.5:
+            return "timeout", peak_mb, f"{took:.1f} s"
+        kind = "abort" if sig == signal.SIGABRT else "crash"
+        return kind, peak_mb, f"signal {sig}: {text.strip()[-300:]}"
+    code = os.WEXITSTATUS(status)
+    if code == 101 or "panicked" in text:
+        return "panic", peak_mb, text.strip()[-300:]
+    if code not in (0, 1):
+        return "crash", peak_mb, f"exit {code}: {text.strip()[-300:]}"
+    lines = [l for l in text.splitlines() if l.strip()]
+    # an error is one line (warnings and notes may come before it)
+    if code == 1 and not (lines and lines[-1].startswith("eenf: error: ")):
+        return "bad-error", peak_mb, text.strip()[-300:]
+    return ("error" if code else "ok"), peak_mb, ""
+
+
+def variants(data, rng, cuts, flips):
+    for k in range(cuts):
+        yield f"cut{k:03d}", data[: len(data) * k // cuts]
+    for k in range(flips):
+        b = bytearray(data)
+        for _ in range(rng.randint(1, 4)):
+            i = rng.randrange(len(b))
+            b[i] ^= 1 << rng.randrange(8)
+        yield f"flip{k:03d}", bytes(b)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("binary")
+    ap.add_argument("fixtures")
+    ap.add_argument("--cuts", type=int, default=200)
+    ap.add_argument("--flips", type=int, default=300)
+    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
+    ap.add_argument("--seed", type=int, default=2026)
+    a = ap.parse_args()
+    files = sorted(
+        os.path.join(d, f)
+        for d, _, fs in os.walk(a.fixtures)
+        for f in fs
+        if not f.endswith((".md", ".json", ".npy")) and f != "LICENSE"
+    )
+    counts = {}
+    worst = {}
+    bad = []
+    peak = 0.0
+    started = time.monotonic()
+    with tempfile.TemporaryDirectory() as work, ThreadPoolExecutor(a.jobs) as pool:
+        for f in files:
+            data = open(f, "rb").read()
+            rng = random.Random(f"{a.seed}:{os.path.basename(f)}")
+            ext = os.path.splitext(f)[1]
+            jobs = []
+            for name, body in variants(data, rng, a.cuts, a.flips):
+                path = os.path.join(work, f"{name}{ext}")
+                with open(path, "wb") as out:
+                    out.write(body)
+                for cmd in COMMANDS:
+                    jobs.append((name, cmd, pool.submit(run, a.binary, cmd, path, work)))
+            for name, cmd, fut in jobs:
+                outcome, mb, detail = fut.result()
+                counts[outcome] = counts.get(outcome, 0) + 1
+                peak = max(peak, mb)
+                worst[cmd] = max(worst.get(cmd, 0.0), mb)
+                if outcome not in ("ok", "error") or mb > MAX_RSS_MB:
+                    bad.append(f"{os.path.basename(f)} {name} {cmd}: {outcome}, {mb:.0f} MB {detail}")
+            for name in os.listdir(work):
+                os.remove(os.path.join(work, name))
+            print(f"  {os.path.basename(f)}: {len(jobs)} runs", flush=True)
+    runs = sum(counts.values())
+    summary = ", ".join(f"{v} {k}" for k, v in sorted(counts.items()))
+    print(f"sweep: {len(files)} fixtures, {runs} runs in {time.monotonic() - started:.0f} s: {summary}")
+    print("peak memory (MB): " + ", ".join(f"{k} {v:.0f}" for k, v in worst.items()) + f"; limit {MAX_RSS_MB}")
+    for b in bad[:40]:
+        print("  " + b)
+    print(f"sweep: {len(bad)} panics/aborts/crashes/timeouts/overruns/bad errors")
+    sys.exit(1 if bad else 0)
+
+
+if __name__ == "__main__":
+    main()
