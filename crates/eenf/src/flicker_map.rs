@@ -42,6 +42,9 @@ pub struct FlickerMap {
     pub whole: Option<FlickerLine>,
     /// Seconds looked at.
     pub seconds: f64,
+    /// What ended the readable part early (damage, a wild timestamp), within those seconds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damage: Option<String>,
 }
 
 impl FlickerMap {
@@ -112,6 +115,7 @@ pub fn flicker_map(
         bar.inc(b.len() as u64);
     }
     bar.finish_and_clear();
+    let damage = reader.damage().map(|d| d.to_string());
     let used = last_bin + 1;
     let fs = 1e6 / BIN_US as f64;
     let whole_x: Vec<f64> = whole[..used].iter().map(|&v| v as f64).collect();
@@ -141,6 +145,7 @@ pub fn flicker_map(
         strength,
         whole: whole_line,
         seconds: used as f64 / fs,
+        damage,
     })
 }
 

@@ -452,8 +452,7 @@ impl Trace {
         // `index,value` rows: without a header (the published ENF traces) or under that one
         let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
         let first = header.split(',').next().unwrap_or("").trim();
-        let index_rows =
-            first.parse::<f64>().is_ok() || header.replace(' ', "") == "index,value";
+        let index_rows = first.parse::<f64>().is_ok() || header.replace(' ', "") == "index,value";
         match index_step_s {
             Some(step) if index_rows => Self::parse_index_csv(text, path, step),
             _ => Self::parse_csv(text, path),

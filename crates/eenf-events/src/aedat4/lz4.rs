@@ -1,5 +1,7 @@
 //! The LZ4 frame format, decoded block by block straight into a reused output buffer
 //! (`lz4_flex`'s streaming decoder copies every byte once more through its own buffer).
+//! Blocks without history go through liblz4's bounds-checked `LZ4_decompress_safe` (the `lz4`
+//! crate); linked blocks, which need the blocks before as a dictionary, through `lz4_flex`.
 
 /// The LZ4 frame magic number.
 const MAGIC: u32 = 0x184D_2204;
@@ -75,13 +77,20 @@ pub(crate) fn decode_frames(input: &[u8], out: &mut Vec<u8>) -> Result<usize, St
                 }
                 out[n..n + len].copy_from_slice(block);
                 n += len;
+            } else if independent || n == frame_start {
+                // no history to refer to: liblz4's bounds-checked LZ4_decompress_safe, about
+                // 1.3x lz4_flex's checked decoder on event packets
+                let k = lz4::block::decompress_to_buffer(
+                    block,
+                    Some(max_block as i32),
+                    &mut out[n..n + max_block],
+                )
+                .map_err(|e| format!("LZ4 decompression failed: {e}"))?;
+                n += k;
             } else {
+                // linked blocks (dv-processing's default) refer back into the blocks before
                 let (before, after) = out.split_at_mut(n);
-                let dict_from = if independent {
-                    n
-                } else {
-                    n.saturating_sub(WINDOW).max(frame_start)
-                };
+                let dict_from = n.saturating_sub(WINDOW).max(frame_start);
                 let k = lz4_flex::block::decompress_into_with_dict(
                     block,
                     &mut after[..max_block],

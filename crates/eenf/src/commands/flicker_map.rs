@@ -29,6 +29,9 @@ pub struct Args {
 
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let map = flicker_map(&a.file, &a.read.options(), a.tile, &progress)?;
+    if let Some(d) = &map.damage {
+        eprintln!("warning: {d}");
+    }
     let whole = match map.whole {
         Some(l) => format!("{:.3} Hz, {:.0} dB over the whole sensor", l.hz, l.db()),
         None => "no line measured".to_string(),
