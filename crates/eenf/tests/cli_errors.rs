@@ -5,6 +5,8 @@ use std::process::Command;
 
 use eenf_events::{Aedat4Writer, Compression};
 
+mod cli;
+
 fn eenf(args: &[&str], dir: &Path) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_eenf"))
         .args(args)
@@ -37,21 +39,7 @@ fn fails(args: &[&str], dir: &Path, file: &str, cause: &str) {
 }
 
 fn simulate(dir: &Path, name: &str, seconds: &str) -> PathBuf {
-    let (ok, _, err) = eenf(
-        &[
-            "-q",
-            "simulate",
-            "--duration",
-            seconds,
-            "--resolution",
-            "24x18",
-            "-o",
-            name,
-        ],
-        dir,
-    );
-    assert!(ok, "{err}");
-    dir.join(name)
+    cli::simulate(dir, name, seconds, &[])
 }
 
 #[test]

@@ -5,27 +5,11 @@
 mod cli;
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use cli::{eenf, fails, ok};
-
-fn simulate(dir: &Path, name: &str, seconds: &str, extra: &[&str]) -> PathBuf {
-    let mut args = vec![
-        "-q",
-        "simulate",
-        "--duration",
-        seconds,
-        "--resolution",
-        "24x18",
-        "-o",
-        name,
-    ];
-    args.extend_from_slice(extra);
-    ok(&args, dir);
-    dir.join(name)
-}
+use cli::{eenf, fails, ok, simulate};
 
 fn names(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)

@@ -37,3 +37,20 @@ pub fn fails(args: &[&str], dir: &Path) -> String {
 pub fn json(text: &str) -> serde_json::Value {
     serde_json::from_str(text).unwrap()
 }
+
+/// Simulates `seconds` of a small (24x18) flickering scene into `dir/name`, with `extra` flags.
+pub fn simulate(dir: &Path, name: &str, seconds: &str, extra: &[&str]) -> std::path::PathBuf {
+    let mut args = vec![
+        "-q",
+        "simulate",
+        "--duration",
+        seconds,
+        "--resolution",
+        "24x18",
+        "-o",
+        name,
+    ];
+    args.extend_from_slice(extra);
+    ok(&args, dir);
+    dir.join(name)
+}
