@@ -255,6 +255,17 @@ fn a_wild_timestamp_ends_the_stream_where_it_is() {
     assert_eq!(StreamStats::scan(r.as_mut()).unwrap().events, 1002);
     let e = expect_err(&path);
     assert!(e.to_string().contains("timestamp jumps"), "{e}");
+    // the limit is exact: 4.9 s and 5 s steps pass, 5.000001 s does not (forwards or back)
+    std::fs::write(
+        &path,
+        "0 1 2 1\n4900000 1 2 1\n9900000 1 2 1\n14900001 1 2 1\n",
+    )
+    .unwrap();
+    let mut r = open(&path).unwrap();
+    assert_eq!(StreamStats::scan(r.as_mut()).unwrap().events, 3);
+    std::fs::write(&path, "20000000 1 2 1\n15000000 1 2 1\n9999999 1 2 1\n").unwrap();
+    let mut r = open(&path).unwrap();
+    assert_eq!(StreamStats::scan(r.as_mut()).unwrap().events, 2);
     // backwards by more than the limit ends it too
     std::fs::write(&path, "10000000 1 2 1\n10000010 1 2 1\n10 1 2 1\n").unwrap();
     let mut r = open(&path).unwrap();
