@@ -174,11 +174,10 @@ impl EventReader for Guarded {
                 offset,
                 reason: format!("{reason}, in the data read from this byte on"),
             };
+            self.ended = true;
             if self.strict {
-                self.ended = true;
                 return Err(e);
             }
-            self.ended = true;
             batch.truncate(i);
             self.damage = Some(Damage {
                 kind: DamageKind::TimeJump,

@@ -180,7 +180,8 @@ pub fn open_file(path: &Path) -> Result<Box<dyn Source>> {
     let mut cache = SPOOLED.lock().unwrap_or_else(|p| p.into_inner());
     let cache = cache.get_or_insert_with(HashMap::new);
     if !cache.contains_key(path) {
-        let mut spool = tempfile_in_tmp().map_err(io)?;
+        // unnamed (O_TMPFILE where it can): nothing is left behind, whatever ends the program
+        let mut spool = tempfile::tempfile().map_err(io)?;
         match file {
             Some(mut f) => std::io::copy(&mut f, &mut spool),
             None => std::io::copy(&mut std::io::stdin().lock(), &mut spool),
@@ -189,35 +190,6 @@ pub fn open_file(path: &Path) -> Result<Box<dyn Source>> {
         cache.insert(path.to_path_buf(), spool);
     }
     reopen(&cache[path]).map_err(io)
-}
-
-/// An unnamed file in the temporary folder, gone when closed.
-fn tempfile_in_tmp() -> std::io::Result<std::fs::File> {
-    let dir = std::env::temp_dir();
-    #[cfg(all(target_os = "linux", target_arch = "x86_64"))]
-    {
-        use std::os::unix::fs::OpenOptionsExt;
-        // O_TMPFILE (x86-64 value): never has a name, so nothing is left behind, whatever ends the program
-        const O_TMPFILE: i32 = 0o20000000 | 0o200000;
-        if let Ok(f) = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .custom_flags(O_TMPFILE)
-            .mode(0o600)
-            .open(&dir)
-        {
-            return Ok(f);
-        }
-    }
-    // elsewhere: a named file, removed at once (the open handle keeps it)
-    let path = dir.join(format!(".eenf-stdin.{}", std::process::id()));
-    let f = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .create_new(true)
-        .open(&path)?;
-    let _ = std::fs::remove_file(&path);
-    Ok(f)
 }
 
 /// A handle on `f` with its own offset (Linux: through `/proc/self/fd`), so that readers opened

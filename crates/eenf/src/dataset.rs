@@ -351,8 +351,14 @@ pub fn relative(base: &Path, path: &Path) -> String {
 /// holds it was left half-built (the run was killed) and is not scored.
 pub const BUILDING_MARKER: &str = ".eenf-building";
 
-/// Refuses a dataset folder that `simulate-dataset` did not finish building.
-pub fn check_complete(dir: &Path) -> Result<()> {
+/// Refuses a dataset (its folder, or a manifest in it) that `simulate-dataset` did not finish
+/// building.
+pub fn check_complete(dataset: &Path) -> Result<()> {
+    let dir = if dataset.is_dir() {
+        dataset
+    } else {
+        crate::output::folder_of(dataset)
+    };
     if dir.join(BUILDING_MARKER).exists() {
         bail!(
             "{}: simulate-dataset did not finish building this dataset (it holds {BUILDING_MARKER}); build it again",

@@ -9,6 +9,7 @@ use eenf_dsp::{agreement, Agreement, EnfParams};
 
 use crate::dataset::{recording_start, reference_hour};
 use crate::extract::Nominal;
+use crate::output::folder_of;
 use crate::reference::{reference_file, reference_for_recording};
 use crate::time::LocalTime;
 use crate::trace::Trace;
@@ -71,12 +72,6 @@ impl Reference {
             };
             return Ok((reference, offset_s));
         }
-        let folder = || {
-            path.parent()
-                .filter(|d| !d.as_os_str().is_empty())
-                .unwrap_or(Path::new("."))
-                .to_path_buf()
-        };
         match (reference_hour(path), recording_start(recording)) {
             // an hourly WAV, no offset given, and a recording whose name says when it started:
             // placed by its name, as in a folder (the next hour's file is read if it runs on)
@@ -94,7 +89,7 @@ impl Reference {
                 }
                 Ok((
                     Reference::Hourly {
-                        dir: folder(),
+                        dir: folder_of(path).to_path_buf(),
                         start,
                     },
                     0.0,
@@ -109,14 +104,10 @@ impl Reference {
         match reference_hour(path) {
             // an hourly WAV and whole seconds into it: the folder form, from that second
             Some(hour) if offset_s >= 0.0 && offset_s.fract() == 0.0 => {
-                let dir = path
-                    .parent()
-                    .filter(|d| !d.as_os_str().is_empty())
-                    .unwrap_or(Path::new("."));
                 let start = LocalTime::from_local_seconds(hour.local_seconds() + offset_s as i64);
                 Ok((
                     Reference::Hourly {
-                        dir: dir.to_path_buf(),
+                        dir: folder_of(path).to_path_buf(),
                         start,
                     },
                     0.0,

@@ -59,13 +59,20 @@ pub fn is_stdout(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
 
+/// The folder that holds `path` (`.` for a bare name).
+pub fn folder_of(path: &Path) -> &Path {
+    path.parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+}
+
 /// Creates the missing parent folders of the output `path`.
 pub fn create_parent(path: &Path) -> Result<()> {
-    match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() && !d.exists() => std::fs::create_dir_all(d)
-            .with_context(|| format!("{}: cannot create the folder", d.display())),
-        _ => Ok(()),
+    let d = folder_of(path);
+    if d.exists() {
+        return Ok(());
     }
+    std::fs::create_dir_all(d).with_context(|| format!("{}: cannot create the folder", d.display()))
 }
 
 /// True when `path` exists and is not a regular file or folder (a device, a FIFO).
@@ -128,10 +135,10 @@ impl AtomicFile {
         if !special {
             create_parent(&target)?;
         }
-        let dir = match target.parent() {
-            _ if special => std::env::temp_dir(),
-            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-            _ => PathBuf::from("."),
+        let dir = if special {
+            std::env::temp_dir()
+        } else {
+            folder_of(&target).to_path_buf()
         };
         let name = target.file_name().unwrap_or_default().to_string_lossy();
         let prefix = format!(".{name}.");

@@ -100,13 +100,7 @@ fn has_extension(p: &Path, list: &[&str]) -> bool {
 /// folder per class holding event files and their `<stem>_lr.*`/`<stem>_hr.*` videos, and
 /// `ENF_Reference/` with hourly WAVs).
 pub fn discover(dataset: &Path) -> Result<Vec<Recording>> {
-    // a tree simulate-dataset left half-built is refused, whether named by folder or manifest
-    let folder = match dataset.parent().filter(|d| !d.as_os_str().is_empty()) {
-        _ if dataset.is_dir() => dataset,
-        Some(parent) => parent,
-        None => Path::new("."),
-    };
-    crate::dataset::check_complete(folder)?;
+    crate::dataset::check_complete(dataset)?;
     if dataset.is_dir() {
         scan_tree(dataset)
     } else if dataset.is_file() {
