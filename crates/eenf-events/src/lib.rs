@@ -24,6 +24,7 @@ mod batch;
 mod error;
 mod guard;
 pub mod jaer;
+pub mod memory;
 pub mod prophesee;
 mod stream;
 pub mod text;
@@ -36,6 +37,7 @@ pub use aedat4::{Aedat4Reader, Aedat4Writer, Compression};
 pub use batch::EventBatch;
 pub use error::{EventError, Result};
 pub use guard::{Damage, DamageKind, DEFAULT_MAX_GAP_US};
+pub use memory::open_events;
 pub use text::TextReader;
 
 /// The formats this version reads, for error messages.

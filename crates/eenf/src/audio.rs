@@ -137,6 +137,88 @@ pub fn read_audio(path: &Path, opts: &AudioOptions) -> Result<Audio> {
     }
 }
 
+/// A recording's sound: a file (any format [`read_audio`] reads), or samples already in
+/// memory (arrays from another library), which are mixed and decimated as a file's are.
+#[derive(Debug, Clone, Copy)]
+pub enum Sound<'a> {
+    /// A sound file, or a video with sound.
+    File(&'a Path),
+    /// Interleaved frames of `channels` channels at `fs` Hz, named `name` in messages.
+    Samples {
+        /// What errors and the trace call them.
+        name: &'a Path,
+        /// The samples, frame after frame.
+        interleaved: &'a [f32],
+        /// Channels per frame.
+        channels: usize,
+        /// Sample rate, Hz.
+        fs: f64,
+    },
+}
+
+impl Sound<'_> {
+    /// Its name in messages and in the trace.
+    pub fn name(&self) -> &Path {
+        match self {
+            Sound::File(p) => p,
+            Sound::Samples { name, .. } => name,
+        }
+    }
+
+    /// Reads it as `opts` says.
+    pub fn read(&self, opts: &AudioOptions) -> Result<Audio> {
+        match *self {
+            Sound::File(p) => read_audio(p, opts),
+            Sound::Samples {
+                name,
+                interleaved,
+                channels,
+                fs,
+            } => audio_from_samples(interleaved, channels, fs, name, opts),
+        }
+    }
+}
+
+/// Sound in memory (`interleaved` frames of `channels` channels at `fs` Hz) read as `opts`
+/// says, with the mix and the streaming decimation a file's sound goes through. NaN or
+/// infinite samples are an error (they would spread through every filter).
+pub fn audio_from_samples(
+    interleaved: &[f32],
+    channels: usize,
+    fs: f64,
+    name: &Path,
+    opts: &AudioOptions,
+) -> Result<Audio> {
+    if !(fs.is_finite() && fs > 0.0) {
+        bail!(
+            "{}: the sample rate must be positive, not {fs}",
+            name.display()
+        );
+    }
+    if channels == 0 || !interleaved.len().is_multiple_of(channels) {
+        bail!(
+            "{}: {} samples do not make whole frames of {channels} channels",
+            name.display(),
+            interleaved.len()
+        );
+    }
+    if let Some(i) = interleaved.iter().position(|v| !v.is_finite()) {
+        bail!(
+            "{}: sample {} (frame {}) is {}: samples must be finite",
+            name.display(),
+            i,
+            i / channels,
+            interleaved[i]
+        );
+    }
+    let mut sink = Sink::new(opts.channel, channels, fs, opts.top_hz)?;
+    // fed in blocks as a decoder's packets would be
+    for block in interleaved.chunks(channels * 4096) {
+        sink.push(block);
+    }
+    finish(Some(sink), fs, name, "memory")
+}
+
 /// Why Symphonia could not read a file: a format it does not know (ffmpeg may), or a real
 /// error (bad channel, damaged stream).
 enum Unreadable {

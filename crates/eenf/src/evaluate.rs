@@ -158,6 +158,18 @@ pub fn compare(
             ..Trace::read(path, Some(*index_step_s))?
         },
     };
+    compare_with(time_s, enf_hz, what, &r, offset_s)
+}
+
+/// Compares the estimate (`time_s`, `enf_hz`; named `what` in errors) with a reference trace
+/// already at hand, shifting estimate times by `offset_s`.
+pub fn compare_with(
+    time_s: &[f64],
+    enf_hz: &[f64],
+    what: &Path,
+    r: &Trace,
+    offset_s: f64,
+) -> Result<Comparison> {
     let (t, e, ref_v) = align(time_s, enf_hz, &r.time_s, &r.enf_hz, offset_s);
     let Some(agreement) = agreement(&e, &ref_v) else {
         bail!(

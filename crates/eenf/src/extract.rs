@@ -1,6 +1,7 @@
 //! E-ENF: an event recording → its polarity sequence → a [`Trace`].
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::{bail, Result};
 use eenf_dsp::{
@@ -8,7 +9,7 @@ use eenf_dsp::{
     flicker_lines, EnfParams, FlickerLine, Grouping, PolaritySequence, SamplingMethod,
     TemporalSampler, MIN_FLICKER_PROMINENCE,
 };
-use eenf_events::{OpenOptions, StreamInfo};
+use eenf_events::{EventBatch, EventReader, OpenOptions, StreamInfo};
 
 use crate::flicker_map::{flicker_map, TileMask};
 use crate::progress::Progress;
@@ -32,6 +33,53 @@ impl std::str::FromStr for Nominal {
             "60" => Ok(Nominal::Hz(60.0)),
             _ => Err(format!("expected 50, 60 or auto, got {s:?}")),
         }
+    }
+}
+
+/// What E-ENF reads: an event file, or events already in memory (arrays from another
+/// library), which take the same path as a file's events.
+#[derive(Debug, Clone)]
+pub enum Recording {
+    /// An event file (any format `eenf_events` reads; `-` is stdin).
+    File(PathBuf),
+    /// Events in memory from a sensor of `width` × `height` pixels, named `name` in messages.
+    Memory {
+        /// What errors and the trace call them.
+        name: PathBuf,
+        /// The events, in time order.
+        events: Arc<EventBatch>,
+        /// Sensor width, pixels.
+        width: u16,
+        /// Sensor height, pixels.
+        height: u16,
+    },
+}
+
+impl Recording {
+    /// The recording of the file at `path`.
+    pub fn file(path: &Path) -> Self {
+        Recording::File(path.to_path_buf())
+    }
+
+    /// Its name in messages and in the trace.
+    pub fn name(&self) -> &Path {
+        match self {
+            Recording::File(p) => p,
+            Recording::Memory { name, .. } => name,
+        }
+    }
+
+    /// Opens it from the start, as `open` says.
+    pub fn open(&self, open: &OpenOptions) -> Result<Box<dyn EventReader>> {
+        Ok(match self {
+            Recording::File(p) => eenf_events::open_with(p, open)?,
+            Recording::Memory {
+                name,
+                events,
+                width,
+                height,
+            } => eenf_events::open_events(events.clone(), *width, *height, name, open)?,
+        })
     }
 }
 
@@ -88,16 +136,16 @@ pub struct Sampled {
     pub damage: Option<eenf_events::Damage>,
 }
 
-/// Reads `path` (as `open` says) into a flicker signal sampled with `sampling` every `dt_us`.
+/// Reads `rec` (as `open` says) into a flicker signal sampled with `sampling` every `dt_us`.
 pub fn sample_with(
-    path: &Path,
+    rec: &Recording,
     open: &OpenOptions,
     sampling: SamplingMethod,
     dt_us: i64,
     progress: &Progress,
 ) -> Result<Sampled> {
-    let reader = eenf_events::open_with(path, open)?;
-    sample_reader(reader, path, sampling, Some(dt_us), None, progress)
+    let reader = rec.open(open)?;
+    sample_reader(reader, rec.name(), sampling, Some(dt_us), None, progress)
 }
 
 /// Reads an opened recording (`path` names it) to its end into a flicker signal.
@@ -151,9 +199,9 @@ fn sample_reader(
     })
 }
 
-/// The flicker line of one camera of `path`, in its 1 ms signal sampled with `method`.
+/// The flicker line of one camera of `rec`, in its 1 ms signal sampled with `method`.
 pub fn camera_line(
-    path: &Path,
+    rec: &Recording,
     open: &OpenOptions,
     camera: u8,
     method: SamplingMethod,
@@ -162,7 +210,7 @@ pub fn camera_line(
         camera: Some(camera),
         ..open.clone()
     };
-    let s = sample_with(path, &one, method, 1000, &Progress::hidden())?;
+    let s = sample_with(rec, &one, method, 1000, &Progress::hidden())?;
     Ok(flicker_line(&s.seq.signal(), s.seq.fs()))
 }
 
@@ -171,16 +219,27 @@ pub fn camera_line(
 /// the peak near 2·grid over the median magnitude in 80–140 Hz. `None` when the recording is
 /// too short to measure.
 pub fn grid_line(path: &Path, open: &OpenOptions, grid_hz: f64) -> Result<Option<FlickerLine>> {
-    let s = sample_with(path, open, SamplingMethod::Sum, 1000, &Progress::hidden())?;
+    let s = sample_with(
+        &Recording::file(path),
+        open,
+        SamplingMethod::Sum,
+        1000,
+        &Progress::hidden(),
+    )?;
     let lines = flicker_lines(&s.seq.signal(), s.seq.fs());
     Ok(lines.map(|[a, b]| if grid_hz == 60.0 { b } else { a }))
 }
 
-/// Reads an event file into its flicker signal. A file with several cameras (a stereo pair,
+/// Reads a recording into its flicker signal. A file with several cameras (a stereo pair,
 /// whose cameras run on two clocks) is read for the camera `opts.open` names, else for the one
 /// whose flicker line stands higher: never a mix of both.
-pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> Result<Sampled> {
-    let reader = eenf_events::open_with(path, &opts.open)?;
+pub fn sample_recording(
+    rec: &Recording,
+    opts: &ExtractOptions,
+    progress: &Progress,
+) -> Result<Sampled> {
+    let path = rec.name();
+    let reader = rec.open(&opts.open)?;
     let cameras = reader.info().cameras.len();
     // the reader opened above serves when it is the one to read
     let (reader, open, note) = if cameras < 2 || opts.open.camera.is_some() {
@@ -189,7 +248,7 @@ pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> R
         let mut best: Option<(u8, f64)> = None;
         let mut heard = Vec::new();
         for c in 0..cameras.min(u8::MAX as usize) as u8 {
-            let line = camera_line(path, &opts.open, c, SamplingMethod::Sum)?;
+            let line = camera_line(rec, &opts.open, c, SamplingMethod::Sum)?;
             let prominence = line.map_or(0.0, |l| l.prominence);
             heard.push(match line {
                 Some(l) => format!("camera {c}: {:.3} Hz, {:.1}x", l.hz, l.prominence),
@@ -210,10 +269,10 @@ pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> R
         };
         (None, open, Some(note))
     };
-    let mask = tile_mask(path, &open, opts, progress)?;
+    let mask = tile_mask(rec, &open, opts, progress)?;
     let reader = match (reader, &mask) {
         (Some(r), None) => r,
-        _ => eenf_events::open_with(path, &open)?,
+        _ => rec.open(&open)?,
     };
     let mut s = sample_reader(
         reader,
@@ -230,7 +289,7 @@ pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> R
 /// The tiles to trace, when `opts` asks for them and the stream stamps its events one by one
 /// (a DVXplorer's scans are sampled whole, as the paper does, and are left alone).
 fn tile_mask(
-    path: &Path,
+    rec: &Recording,
     open: &OpenOptions,
     opts: &ExtractOptions,
     progress: &Progress,
@@ -243,7 +302,7 @@ fn tile_mask(
     {
         return Ok(None);
     }
-    let mut reader = eenf_events::open_with(path, open)?;
+    let mut reader = rec.open(open)?;
     if reader.info().width.is_none() {
         return Ok(None);
     }
@@ -254,13 +313,24 @@ fn tile_mask(
         return Ok(None);
     }
     drop(reader);
-    let map = flicker_map(path, open, None, progress)?;
+    let map = flicker_map(rec, open, None, progress)?;
     Ok(TileMask::from_map(&map))
+}
+
+/// Reads an event file into its flicker signal (see [`sample_recording`]).
+pub fn sample_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> Result<Sampled> {
+    sample_recording(&Recording::file(path), opts, progress)
 }
 
 /// E-ENF from an event file.
 pub fn extract_file(path: &Path, opts: &ExtractOptions, progress: &Progress) -> Result<Trace> {
-    let s = sample_file(path, opts, progress)?;
+    extract(&Recording::file(path), opts, progress)
+}
+
+/// E-ENF from a recording: a file, or events in memory.
+pub fn extract(rec: &Recording, opts: &ExtractOptions, progress: &Progress) -> Result<Trace> {
+    let path = rec.name();
+    let s = sample_recording(rec, opts, progress)?;
     // when what was left before the damage is not enough, the error says why so little was read
     let damage = s.damage.as_ref().map(|d| d.message.clone());
     extract_sampled(path, s, opts, progress).map_err(|e| match damage {

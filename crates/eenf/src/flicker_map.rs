@@ -1,13 +1,12 @@
 //! Where the flicker is: the mains line's strength in each tile of pixels, a picture in which a
 //! person sees the lamp and the surfaces it lights.
 
-use std::path::Path;
-
 use anyhow::{bail, Result};
 use eenf_dsp::{flicker_lines, line_strength_at, FlickerLine};
 use eenf_events::OpenOptions;
 use rayon::prelude::*;
 
+use crate::extract::Recording;
 use crate::progress::Progress;
 
 /// Seconds of the recording the map looks at (the line is steady; memory stays bounded).
@@ -61,15 +60,16 @@ impl FlickerMap {
     }
 }
 
-/// Maps the flicker of the file at `path` (read as `open` says) over its first
+/// Maps the flicker of the recording `rec` (read as `open` says) over its first
 /// [`MAP_SECONDS`]: tiles of `tile` pixels (default: at most 32 tiles across).
 pub fn flicker_map(
-    path: &Path,
+    rec: &Recording,
     open: &OpenOptions,
     tile: Option<u16>,
     progress: &Progress,
 ) -> Result<FlickerMap> {
-    let mut reader = eenf_events::open_with(path, open)?;
+    let path = rec.name();
+    let mut reader = rec.open(open)?;
     let info = reader.info().clone();
     let (Some(width), Some(height)) = (info.width, info.height) else {
         bail!(

@@ -7,7 +7,7 @@ use anyhow::Result;
 use eenf_dsp::{flicker_line, FlickerLine, Grouping, SamplingMethod, TemporalSampler};
 use eenf_events::{OpenOptions, StreamInfo, StreamStats};
 
-use crate::extract::camera_line;
+use crate::extract::{camera_line, Recording};
 
 /// The flicker of one camera.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -41,7 +41,8 @@ pub struct Inspection {
 /// Reads `path` (as `open` says) to the end: its statistics, and the flicker line (1 ms
 /// ON − OFF sums) of each camera, or of the camera `open` names.
 pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
-    let mut reader = eenf_events::open_with(path, open)?;
+    let rec = Recording::file(path);
+    let mut reader = rec.open(open)?;
     let info = reader.info().clone();
     let mut stats = StreamStats::default();
     let mut sampler = TemporalSampler::new(SamplingMethod::Sum, 1000);
@@ -68,8 +69,8 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
         for c in 0..info.cameras.len().min(u8::MAX as usize) as u8 {
             out.push(CameraFlicker {
                 camera: Some(c),
-                line: camera_line(path, open, c, SamplingMethod::Auto)?,
-                sum_line: camera_line(path, open, c, SamplingMethod::Sum)?,
+                line: camera_line(&rec, open, c, SamplingMethod::Auto)?,
+                sum_line: camera_line(&rec, open, c, SamplingMethod::Sum)?,
             });
         }
         out
@@ -88,4 +89,66 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
         flicker,
         damage,
     })
+}
+
+impl Inspection {
+    /// Seconds from the first event to the last, and events per second over them.
+    pub fn duration_and_rate(&self) -> (f64, f64) {
+        let s = &self.stats;
+        let duration_s = match (s.first_t, s.last_t) {
+            (Some(f), Some(l)) => (l - f) as f64 * 1e-6,
+            _ => 0.0,
+        };
+        let rate = if duration_s > 0.0 {
+            s.events as f64 / duration_s
+        } else {
+            0.0
+        };
+        (duration_s, rate)
+    }
+
+    /// Width and height: the header's, else the events' extent.
+    pub fn resolution(&self) -> (Option<u16>, Option<u16>) {
+        let (info, s) = (&self.info, &self.stats);
+        (
+            info.width.or(s.x_range.map(|r| r.1 + 1)),
+            info.height.or(s.y_range.map(|r| r.1 + 1)),
+        )
+    }
+
+    /// The inspection of `file` as `eenf info --json` prints it.
+    pub fn to_json(&self, file: &Path) -> serde_json::Value {
+        let (info, stats) = (&self.info, &self.stats);
+        let (duration_s, rate) = self.duration_and_rate();
+        let (width, height) = self.resolution();
+        let sampling = self.grouping.map(|g| g.choice());
+        let streams: Vec<_> = info
+            .streams
+            .iter()
+            .map(|s| {
+                serde_json::json!({"id": s.id, "type": s.kind, "width": s.width,
+                    "height": s.height, "source": s.source})
+            })
+            .collect();
+        let skipped: std::collections::BTreeMap<String, u64> = self
+            .skipped
+            .iter()
+            .map(|(k, n)| (k.to_string(), *n))
+            .collect();
+        serde_json::json!({
+            "file": file, "format": info.format, "codec": info.codec,
+            "width": width, "height": height, "streams": streams, "indexed": info.indexed,
+            "events": stats.events, "on_events": stats.on,
+            "first_t_us": stats.first_t, "last_t_us": stats.last_t,
+            "duration_s": duration_s, "events_per_s": rate,
+            "x_range": stats.x_range, "y_range": stats.y_range,
+            "skipped": skipped,
+            "cameras": info.cameras, "notes": info.notes,
+            "sampling": sampling.as_ref().map(|s| serde_json::json!({"auto": s.0, "why": s.1})),
+            "flicker": self.flicker,
+            "damage": self.damage.as_ref().map(|d| serde_json::json!({
+                "kind": d.kind.to_string(), "offset": d.offset,
+                "events_before": d.events_before, "message": d.message})),
+        })
+    }
 }

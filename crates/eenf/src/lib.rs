@@ -10,11 +10,14 @@
 //! - [`bench`]: every method over a dataset, Table 2 and figures; [`simulation`] and
 //!   [`dataset`]: simulated recordings and datasets with their truth.
 //!
+//! [`args`] holds the option sets of the command line, parsed into the library's types, which the
+//! `eenf` command and the Python package share (names, defaults, checks and messages).
 //! [`trace`] reads and writes traces, [`output`] writes every file whole or not at all,
 //! [`time`] holds all calendar and time-zone work.
 
 #![forbid(unsafe_code)]
 
+pub mod args;
 pub mod audio;
 pub mod bench;
 pub mod dataset;

@@ -13,7 +13,7 @@ use eenf::output::write_atomic;
 use eenf::progress::Progress;
 use eenf_video::{IdleRows, RowSampling, SceneRemoval, VideoOptions};
 
-use super::args::{one_of, MethodArgs};
+use eenf::args::{one_of, MethodArgs};
 
 /// Arguments of `eenf bench`.
 #[derive(Debug, clap::Args)]

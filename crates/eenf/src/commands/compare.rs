@@ -10,7 +10,7 @@ use eenf::progress::Progress;
 use eenf::trace::Trace;
 use eenf_dsp::{EnfParams, PeakMethod};
 
-use super::args::one_of;
+use eenf::args::one_of;
 
 /// Arguments of `eenf compare`.
 #[derive(Debug, clap::Args)]

@@ -7,7 +7,7 @@ use eenf::output::write_events;
 use eenf::progress::Progress;
 use eenf_events::StreamStats;
 
-use super::args::{EventOutputArgs, InputArgs};
+use eenf::args::{EventOutputArgs, InputArgs};
 
 /// Arguments of `eenf convert`.
 #[derive(Debug, clap::Args)]

@@ -7,7 +7,7 @@ use eenf::extract::extract_file;
 use eenf::plot::plot_extraction;
 use eenf::progress::Progress;
 
-use super::args::{MethodArgs, TraceOutputArgs};
+use eenf::args::{MethodArgs, TraceOutputArgs};
 
 /// Arguments of `eenf extract`.
 #[derive(Debug, clap::Args)]

@@ -7,7 +7,7 @@ use eenf::flicker_map::{flicker_map, MAP_SECONDS};
 use eenf::plot::plot_flicker_map;
 use eenf::progress::Progress;
 
-use super::args::InputArgs;
+use eenf::args::InputArgs;
 
 /// Arguments of `eenf flicker-map`.
 #[derive(Debug, clap::Args)]
@@ -28,7 +28,8 @@ pub struct Args {
 }
 
 pub fn run(a: Args, progress: Progress) -> Result<()> {
-    let map = flicker_map(&a.file, &a.read.options(), a.tile, &progress)?;
+    let rec = eenf::extract::Recording::file(&a.file);
+    let map = flicker_map(&rec, &a.read.options(), a.tile, &progress)?;
     if let Some(d) = &map.damage {
         eprintln!("warning: {d}");
     }

@@ -6,7 +6,7 @@ use anyhow::Result;
 use eenf::inspect::{inspect, CameraFlicker};
 use eenf::time::utc_micros;
 
-use super::args::InputArgs;
+use eenf::args::InputArgs;
 
 /// Arguments of `eenf info`.
 #[derive(Debug, clap::Args)]
@@ -53,47 +53,14 @@ fn flicker_text(f: &CameraFlicker) -> String {
 
 pub fn run(a: Args) -> Result<()> {
     let found = inspect(&a.file, &a.read.options())?;
-    let (info, stats, skipped) = (&found.info, &found.stats, &found.skipped);
-    let sampling = found.grouping.map(|g| g.choice());
-    let duration_s = match (stats.first_t, stats.last_t) {
-        (Some(f), Some(l)) => (l - f) as f64 * 1e-6,
-        _ => 0.0,
-    };
-    let rate = if duration_s > 0.0 {
-        stats.events as f64 / duration_s
-    } else {
-        0.0
-    };
-    // resolution: header, else the data's extent
-    let width = info.width.or(stats.x_range.map(|r| r.1 + 1));
-    let height = info.height.or(stats.y_range.map(|r| r.1 + 1));
     if a.json {
-        let streams: Vec<_> = info
-            .streams
-            .iter()
-            .map(|s| {
-                serde_json::json!({"id": s.id, "type": s.kind, "width": s.width,
-                    "height": s.height, "source": s.source})
-            })
-            .collect();
-        let v = serde_json::json!({
-            "file": a.file, "format": info.format, "codec": info.codec,
-            "width": width, "height": height, "streams": streams, "indexed": info.indexed,
-            "events": stats.events, "on_events": stats.on,
-            "first_t_us": stats.first_t, "last_t_us": stats.last_t,
-            "duration_s": duration_s, "events_per_s": rate,
-            "x_range": stats.x_range, "y_range": stats.y_range,
-            "skipped": skipped.iter().map(|(k, n)| (k.to_string(), *n)).collect::<std::collections::BTreeMap<_, _>>(),
-            "cameras": info.cameras, "notes": info.notes,
-            "sampling": sampling.as_ref().map(|s| serde_json::json!({"auto": s.0, "why": s.1})),
-            "flicker": found.flicker,
-            "damage": found.damage.as_ref().map(|d| serde_json::json!({
-                "kind": d.kind.to_string(), "offset": d.offset,
-                "events_before": d.events_before, "message": d.message})),
-        });
-        outln!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&found.to_json(&a.file))?);
         return Ok(());
     }
+    let (info, stats) = (&found.info, &found.stats);
+    let sampling = found.grouping.map(|g| g.choice());
+    let (duration_s, rate) = found.duration_and_rate();
+    let (width, height) = found.resolution();
     outln!("file        {}", a.file.display());
     match &info.codec {
         Some(c) => outln!("format      {} (compression {c})", info.format),

@@ -2,15 +2,15 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use eenf::plot::plot_comparison;
 use eenf::progress::Progress;
-use eenf::reference::ReferenceSeries;
-use eenf::time::{parse_time, tz_offset};
+use eenf::reference::{match_grid, match_trace_in, ReferenceSeries};
+use eenf::time::tz_offset;
 use eenf::trace::Trace;
-use eenf_dsp::matching::{resample, MatchOptions, Score, DEFAULT_ALPHA};
+use eenf_dsp::matching::resample;
 
-use super::args::one_of;
+use eenf::args::MatchArgs;
 
 /// Arguments of `eenf match`.
 #[derive(Debug, clap::Args)]
@@ -20,22 +20,8 @@ pub struct Args {
     /// Where to look: a store from `eenf refdb build`, a folder of hourly mains WAVs, a WAV,
     /// or a trace CSV.
     pub reference: PathBuf,
-    /// Candidates to list.
-    #[arg(long, default_value_t = 5)]
-    pub top: usize,
-    /// Check a claimed start time (e.g. 2022-08-17T16:10:00+08:00): its score, rank and
-    /// significance.
-    #[arg(long)]
-    pub verify: Option<String>,
-    /// Ranking score: `combined` (shape and level) or `cc` (shape only, robust to a bias).
-    #[arg(long, default_value = "combined", value_parser = one_of::<Score>(&Score::NAMES))]
-    pub score: Score,
-    /// A candidate is a match when its p-value is below this.
-    #[arg(long, default_value_t = DEFAULT_ALPHA)]
-    pub alpha: f64,
-    /// UTC offset of local times in WAV names.
-    #[arg(long, default_value = "+00:00", allow_hyphen_values = true)]
-    pub tz: String,
+    #[command(flatten)]
+    pub search: MatchArgs,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
@@ -46,64 +32,22 @@ pub struct Args {
 
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let trace = Trace::read(&a.trace, None)?;
-    if trace.enf_hz.len() < 2 {
-        bail!("{}: too short to match", a.trace.display());
-    }
-    let step = trace.step_s;
-    if step <= 0.0 {
-        bail!("{}: times must increase", a.trace.display());
-    }
-    let nominal = trace.grid_hz().with_context(|| {
-        format!(
-            "{}: mean {:.3} Hz is neither a 50 nor a 60 Hz grid",
-            a.trace.display(),
-            trace.mean_hz()
-        )
-    })?;
-    let tz = tz_offset(&a.tz)?;
+    let nominal = match_grid(&trace, &a.trace)?;
+    let tz = tz_offset(&a.search.tz)?;
     let refs = ReferenceSeries::load(&a.reference, nominal, tz, &progress)?;
-    let started = std::time::Instant::now();
-    let mut rows = Vec::new();
-    let mut verification = None;
-    for r in &refs {
-        let q = resample(&trace.enf_hz, step, r.step);
-        let verify = match &a.verify {
-            Some(t) => {
-                let at = if r.absolute {
-                    parse_time(t)?
-                } else {
-                    t.parse::<f64>()
-                        .context("--verify with a relative reference takes seconds")?
-                };
-                let k = ((at - r.start) / r.step).round();
-                (k >= 0.0).then_some(k as usize)
-            }
-            None => None,
-        };
-        let opts = MatchOptions {
-            top: a.top,
-            score: a.score,
-            verify,
-            ..MatchOptions::default()
-        };
-        let res = r
-            .values
-            .search(&q, &opts)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", a.trace.display()))?;
-        if let Some(v) = res.verification {
-            verification = Some((r, v));
-        }
-        for c in res.candidates {
-            rows.push((r, c));
-        }
-    }
-    rows.sort_by(|x, y| {
-        x.1.p_value
-            .total_cmp(&y.1.p_value)
-            .then(y.1.agreement.cc.total_cmp(&x.1.agreement.cc))
-    });
-    rows.truncate(a.top);
-    let took = started.elapsed().as_secs_f64();
+    let query = a.search.query();
+    let report = match_trace_in(&trace, &a.trace, &refs, &query)?;
+    let rows: Vec<_> = report
+        .placements
+        .iter()
+        .map(|p| (&refs[p.series], &p.candidate))
+        .collect();
+    let verification = report
+        .verified
+        .as_ref()
+        .map(|v| (&refs[v.series], &v.verification));
+    let took = report.seconds;
+    let step = trace.step_s;
     let when = |r: &ReferenceSeries, offset: f64| r.time_label(offset);
     if let (Some(p), Some((r, c))) = (&a.plot, rows.first()) {
         let k = c.offset.round() as usize;
@@ -126,24 +70,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         )?;
     }
     if a.json {
-        let cands: Vec<_> = rows
-            .iter()
-            .map(|(r, c)| {
-                serde_json::json!({"reference": r.name, "start": when(r, c.offset),
-                    "start_s": r.start + c.offset * r.step, "offset_steps": c.offset,
-                    "cc": c.agreement.cc, "mae_hz": c.agreement.mae_hz,
-                    "rmse_hz": c.agreement.rmse_hz, "overlap": c.agreement.n,
-                    "p_value": c.p_value, "match": c.p_value < a.alpha})
-            })
-            .collect();
-        let v = serde_json::json!({
-            "trace": a.trace, "nominal_hz": nominal, "alpha": a.alpha, "seconds": took,
-            "candidates": cands,
-            "verify": verification.map(|(r, v)| serde_json::json!({
-                "time": when(r, v.offset as f64), "cc": v.agreement.cc,
-                "mae_hz": v.agreement.mae_hz, "rmse_hz": v.agreement.rmse_hz, "rank": v.rank, "p_value": v.p_value,
-                "best_fit": v.rank == 1, "consistent": v.rank == 1 && v.p_value < a.alpha})),
-        });
+        let v = report.to_json(&a.trace, &refs, query.alpha);
         outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
@@ -173,10 +100,14 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             c.agreement.rmse_hz * 1e3,
             c.agreement.n,
             c.p_value,
-            if c.p_value < a.alpha { "  match" } else { "" }
+            if c.p_value < query.alpha {
+                "  match"
+            } else {
+                ""
+            }
         );
     }
-    if let Some(t) = &a.verify {
+    if let Some(t) = &query.verify {
         match verification {
             Some((r, v)) => outln!(
                 "claimed {t} ({}): CC {:.4}, MAE {:.3} mHz, rank {}, p {:.1e}: {}",
@@ -185,7 +116,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
                 v.agreement.mae_hz * 1e3,
                 v.rank,
                 v.p_value,
-                match (v.rank == 1, v.p_value < a.alpha) {
+                match (v.rank == 1, v.p_value < query.alpha) {
                     (true, true) => "consistent: the best fit in the reference, and significant".to_string(),
                     (true, false) => "the best fit in the reference, but not significant (the trace is too short or flat to tell)".to_string(),
                     (false, _) => format!("not supported: {} other places fit better", v.rank - 1),

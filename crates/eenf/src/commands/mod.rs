@@ -11,7 +11,6 @@ macro_rules! outln {
     };
 }
 
-pub mod args;
 pub mod bench;
 pub mod compare;
 pub mod convert;

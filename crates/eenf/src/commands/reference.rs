@@ -6,7 +6,7 @@ use anyhow::Result;
 use eenf::progress::Progress;
 use eenf::reference::audio_trace;
 
-use super::args::{TraceOutputArgs, TrackerArgs};
+use eenf::args::{AudioArgs, TraceOutputArgs, TrackerArgs};
 
 /// Arguments of `eenf reference`.
 #[derive(Debug, clap::Args)]
@@ -14,14 +14,8 @@ pub struct Args {
     /// The recording: a mains WAV, or any sound (WAV, FLAC, MP3, M4A/AAC, OGG, or a video's
     /// soundtrack through ffmpeg), at any sample rate.
     pub wav: PathBuf,
-    /// The channel traced: `mix` (the mean of all) or a number from 0.
-    #[arg(long, default_value = "mix")]
-    pub channel: eenf::audio::Channel,
-    /// Mains lines tracked: 1 tracks f0 alone (the method's reference tracker); N tracks f0 …
-    /// N·f0 band by band and takes, per segment, the band the selection rule picks among those
-    /// that stand above their noise (hum is often stronger at 2f0 or 3f0).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=8))]
-    pub harmonics: u32,
+    #[command(flatten)]
+    pub audio: AudioArgs,
     #[command(flatten)]
     pub out: TraceOutputArgs,
     #[command(flatten)]
@@ -32,14 +26,10 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let params = a.tracker.params()?;
     let spin = progress.spinner("tracking the mains frequency");
     let started = std::time::Instant::now();
-    let audio = eenf::audio::AudioOptions {
-        channel: a.channel,
-        top_hz: None,
-    };
     let trace = audio_trace(
         &a.wav,
-        &audio,
-        a.harmonics as usize,
+        &a.audio.options(),
+        a.audio.harmonics as usize,
         a.tracker.nominal,
         &params,
     )?;

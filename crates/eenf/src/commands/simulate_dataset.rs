@@ -14,7 +14,7 @@ use eenf::time::{tz_offset, LocalTime};
 use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;
 
-use super::args::{one_of, parse_readout, parse_resolution, VideoArgs};
+use eenf::args::{one_of, parse_readout, parse_resolution, VideoArgs};
 
 /// Arguments of `eenf simulate-dataset`.
 #[derive(Debug, Clone, clap::Args)]

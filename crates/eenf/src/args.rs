@@ -1,16 +1,20 @@
-//! Flags shared by several commands, parsed into the library's types. Option names come from
+//! The command line's option sets (flags shared by several commands, and those the Python
+//! package takes as keyword arguments), parsed into the library's types. Option names come from
 //! the library enums' `FromStr`/`Display` (their `NAMES` list the values `--help` shows).
 
 use std::path::PathBuf;
 use std::str::FromStr;
 
+use crate::extract::{ExtractOptions, Nominal};
+use crate::simulation::{EnfSource, Recipe};
 use anyhow::{bail, Context, Result};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
-use eenf::extract::{ExtractOptions, Nominal};
 use eenf_dsp::{EnfParams, HarmonicSelection, PeakMethod, SamplingMethod};
 use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;
+use eenf_sim::SimConfig;
 use eenf_sim::{Lamp, SceneKind};
+use eenf_video::{IdleRows, RowSampling, SceneRemoval, VideoOptions};
 
 /// A clap parser for a library enum: one of `names`, parsed by the enum's `FromStr`.
 pub fn one_of<T>(names: &'static [&'static str]) -> impl TypedValueParser<Value = T>
@@ -45,6 +49,7 @@ pub struct TrackerArgs {
 /// Event-method flags (`extract`, `bench`).
 #[derive(Debug, Clone, clap::Args)]
 pub struct MethodArgs {
+    /// The tracker's flags.
     #[command(flatten)]
     pub tracker: TrackerArgs,
     /// Temporal sampling: auto (paper when events come in scan groups that share a timestamp,
@@ -93,6 +98,7 @@ pub struct MethodArgs {
     /// `flicker-map`'s), so that motion and noise elsewhere drop out.
     #[arg(long)]
     pub all_pixels: bool,
+    /// How the file is read.
     #[command(flatten)]
     pub input: InputArgs,
 }
@@ -229,7 +235,7 @@ impl VideoArgs {
     /// The cameras asked for (none without `--video`).
     pub fn cameras(&self) -> Result<Vec<eenf_sim::CameraConfig>> {
         match &self.video {
-            Some(list) => eenf::simulation::parse_cameras(list, self.video_scale),
+            Some(list) => crate::simulation::parse_cameras(list, self.video_scale),
             None => Ok(Vec::new()),
         }
     }
@@ -248,15 +254,15 @@ pub struct TraceOutputArgs {
 
 impl TraceOutputArgs {
     /// Writes the trace file, if one was asked for, and says so on stderr.
-    pub fn save(&self, trace: &eenf::trace::Trace) -> Result<()> {
+    pub fn save(&self, trace: &crate::trace::Trace) -> Result<()> {
         if let Some(out) = &self.output {
-            eenf::output::write_atomic(out, |w| trace.write_for(out, w))?;
+            crate::output::write_atomic(out, |w| trace.write_for(out, w))?;
         }
         Ok(())
     }
 
     /// Prints the trace on stdout: JSON with `--json`, else CSV unless it went to a file.
-    pub fn print(&self, trace: &eenf::trace::Trace) -> Result<()> {
+    pub fn print(&self, trace: &crate::trace::Trace) -> Result<()> {
         let stdout = std::io::stdout();
         let mut lock = stdout.lock();
         if self.json {
@@ -271,7 +277,7 @@ impl TraceOutputArgs {
     /// Says where the trace went (stderr).
     pub fn report(&self) {
         match &self.output {
-            Some(out) if eenf::output::is_stdout(out) => {}
+            Some(out) if crate::output::is_stdout(out) => {}
             Some(out) => eprintln!("trace written to {}", out.display()),
             None => {}
         }
@@ -334,4 +340,282 @@ pub fn parse_lamps(s: &str) -> Result<Vec<Lamp>> {
 pub fn parse_readout(s: &str) -> Result<eenf_sim::Readout> {
     eenf_sim::Readout::named(s)
         .with_context(|| format!("--readout {s:?}: expected dvxplorer, prophesee or dvs128"))
+}
+
+/// How a recording's sound is read and tracked (`reference`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct AudioArgs {
+    /// The channel traced: `mix` (the mean of all) or a number from 0.
+    #[arg(long, default_value = "mix")]
+    pub channel: crate::audio::Channel,
+    /// Mains lines tracked: 1 tracks f0 alone (the method's reference tracker); N tracks f0 …
+    /// N·f0 band by band and takes, per segment, the band the selection rule picks among those
+    /// that stand above their noise (hum is often stronger at 2f0 or 3f0).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=8))]
+    pub harmonics: u32,
+}
+
+impl AudioArgs {
+    /// The reading options (the rate follows from the harmonics tracked).
+    pub fn options(&self) -> crate::audio::AudioOptions {
+        crate::audio::AudioOptions {
+            channel: self.channel,
+            top_hz: None,
+        }
+    }
+}
+
+/// V-ENF flags (`video`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct VideoMethodArgs {
+    /// Grid frequency, 50 or 60 (default: detected from the flicker).
+    #[arg(long)]
+    pub nominal: Option<f64>,
+    /// The sensor's readout time (first row to last row), ms: sets the idle rows.
+    #[arg(long, conflicts_with_all = ["idle", "virtual_rows"])]
+    pub readout_ms: Option<f64>,
+    /// Idle rows: `auto` estimates them from the flicker's ripple within frames.
+    #[arg(long, value_parser = ["auto"])]
+    pub idle: Option<String>,
+    /// Virtual rows per frame period (real plus idle), if known.
+    #[arg(long, conflicts_with = "idle")]
+    pub virtual_rows: Option<f64>,
+    /// Row sampling: zero-pad (idle rows as zeros), naive (rows concatenated), global (one
+    /// sample per frame, tracked at the alias of the flicker).
+    #[arg(long, default_value = "zero-pad", value_parser = one_of::<RowSampling>(&RowSampling::NAMES))]
+    pub sampling: RowSampling,
+    /// Scene removal: paper (each frame minus the mean of it and the next), row-mean (each
+    /// row minus its mean over a second), none.
+    #[arg(long, default_value = "paper", value_parser = one_of::<SceneRemoval>(&SceneRemoval::NAMES))]
+    pub scene_removal: SceneRemoval,
+    /// Peak refinement of the tracker: exact or paper.
+    #[arg(long, default_value = "exact", value_parser = one_of::<PeakMethod>(&PeakMethod::NAMES))]
+    pub peak: PeakMethod,
+    /// STFT window, s.
+    #[arg(long, default_value_t = 16.0)]
+    pub window: f64,
+}
+
+impl VideoMethodArgs {
+    /// The V-ENF options these arguments ask for.
+    pub fn options(&self) -> Result<VideoOptions> {
+        if let Some(n) = self.nominal {
+            if n != 50.0 && n != 60.0 {
+                bail!("--nominal must be 50 or 60, not {n}");
+            }
+        }
+        let idle = match (self.readout_ms, self.virtual_rows) {
+            (Some(ms), _) if ms > 0.0 => IdleRows::ReadoutS(ms / 1e3),
+            (Some(ms), _) => bail!("--readout-ms must be positive, not {ms}"),
+            (None, Some(l)) if l > 0.0 => IdleRows::VirtualRows(l),
+            (None, Some(l)) => bail!("--virtual-rows must be positive, not {l}"),
+            (None, None) => IdleRows::Auto,
+        };
+        let sampling = match self.sampling {
+            RowSampling::ZeroPad(_) => RowSampling::ZeroPad(idle),
+            other => other,
+        };
+        let params = EnfParams {
+            nominal_hz: self.nominal.unwrap_or(50.0),
+            window_s: self.window,
+            peak: self.peak,
+            ..EnfParams::default()
+        };
+        Ok(VideoOptions {
+            nominal_hz: self.nominal,
+            sampling,
+            scene_removal: self.scene_removal,
+            params,
+        })
+    }
+}
+
+/// Simulation flags (`simulate`): the scene, the sensor, the ENF, the outputs.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SimulateArgs {
+    /// Scene classes, comma-separated (mixes allowed): static, dynamic-object,
+    /// dynamic-camera, extreme-dim, extreme-bright, lamp-spot (a daylit room where only a
+    /// lamp's pool, ~5 % of the view, flickers, and a person walks by).
+    #[arg(long, default_value = "static")]
+    pub scene: String,
+    /// Lamps, comma-separated (at most 3), each KIND[@PHASE_DEG][*SHARE] with KIND one of
+    /// incandescent, fluorescent, led, sinusoid; e.g. `led,fluorescent@120`.
+    #[arg(long, default_value = "led")]
+    pub lamp: String,
+    /// Length of the recording, s.
+    #[arg(long, default_value_t = 60.0)]
+    pub duration: f64,
+    /// Where the ENF comes from: `synthetic` (a grid-like random process), a mains WAV or a
+    /// trace CSV (`time_s,enf_hz`, or `index,value` at --enf-step), optionally with a start
+    /// second (`ref.wav:600`).
+    #[arg(long, default_value = "synthetic")]
+    pub enf: String,
+    /// Seconds between the values of an `index,value` trace CSV.
+    #[arg(long, default_value_t = 2.0)]
+    pub enf_step: f64,
+    /// Grid frequency of a synthetic ENF: 50 or 60 (a WAV's or trace's own is detected).
+    #[arg(long, default_value_t = 50)]
+    pub grid: u32,
+    /// Output recording; the format follows the extension (.aedat4, .raw = EVT 3.0, .dat,
+    /// .txt) unless --format says. The truth goes beside it as NAME.truth.csv, every
+    /// parameter as NAME.sim.json.
+    #[arg(short, long, default_value = "simulated.aedat4")]
+    pub output: PathBuf,
+    /// Sensor resolution WxH.
+    #[arg(long, default_value = "64x48")]
+    pub resolution: String,
+    /// Random seed (same seed, same recording).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Readout: dvxplorer (scans, shared timestamps, finite bandwidth), prophesee (µs
+    /// timestamps) or dvs128 (an arbiter serving one event at a time, each with its own µs).
+    #[arg(long, default_value = "dvxplorer")]
+    pub readout: String,
+    /// Overall light level (1 = indoor room); the scene classes set their own.
+    #[arg(long)]
+    pub illumination: Option<f64>,
+    /// Share of non-flickering light (daylight), 0..1.
+    #[arg(long)]
+    pub ambient: Option<f64>,
+    /// How much brighter the first lamp is inside its pool (`lamp-spot`) or bulb
+    /// (`extreme-bright`) than elsewhere: sets how strongly those pixels flicker.
+    #[arg(long)]
+    pub spot_gain: Option<f64>,
+    /// Background activity: each pixel's noise events per second under an indoor room's
+    /// light (more in the dark), e.g. 0.5 for an old DVS128. Default: the simulator's 0.02.
+    #[arg(long)]
+    pub noise_hz: Option<f64>,
+    /// Local start time of the recording (names, timestamps; a WAV or CSV source named with
+    /// its time sets it).
+    #[arg(long, default_value = crate::simulation::DEFAULT_START)]
+    pub start: String,
+    /// Also write the hourly mains references (400 Hz WAVs named like the dataset's) that
+    /// cover the recording into this folder.
+    #[arg(long)]
+    pub reference_dir: Option<PathBuf>,
+    /// The recording's format.
+    #[command(flatten)]
+    pub events: EventOutputArgs,
+    /// Videos rendered beside it.
+    #[command(flatten)]
+    pub video: VideoArgs,
+}
+
+/// The simulation configuration from the arguments (its start is set from the timeline).
+fn config(a: &SimulateArgs) -> Result<SimConfig> {
+    if !(a.duration > 0.0 && a.duration <= 24.0 * 3600.0) {
+        bail!("--duration must be between 0 and 86400 s");
+    }
+    let (width, height) = parse_resolution(&a.resolution)?;
+    let readout = parse_readout(&a.readout)?;
+    let mut config = SimConfig {
+        width,
+        height,
+        duration_s: a.duration,
+        seed: a.seed,
+        lamps: parse_lamps(&a.lamp)?,
+        readout,
+        ..SimConfig::default()
+    }
+    .with_kinds(&parse_scene(&a.scene)?);
+    if let Some(i) = a.illumination {
+        config.illumination = i;
+    }
+    if let Some(x) = a.ambient {
+        config.ambient = x;
+    }
+    if let Some(g) = a.spot_gain {
+        match config.scene.bulb.as_mut() {
+            Some(b) if g > 0.0 => b.gain = g,
+            Some(_) => bail!("--spot-gain must be positive"),
+            None => {
+                bail!("--spot-gain needs a scene with a lamp in view (lamp-spot, extreme-bright)")
+            }
+        }
+    }
+    if let Some(n) = a.noise_hz {
+        if !(n >= 0.0 && n.is_finite()) {
+            bail!("--noise-hz must be zero or positive");
+        }
+        config.pixel.shot_noise_hz = n;
+        config.pixel.shot_noise_max_hz = config.pixel.shot_noise_max_hz.max(4.0 * n);
+    }
+    config.check().map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(config)
+}
+
+/// The ENF source named by `--enf` (`synthetic`, or PATH[:START]: a colon followed by a
+/// number is the start second).
+fn enf_source(a: &SimulateArgs) -> Result<EnfSource> {
+    if a.enf == "synthetic" {
+        return Ok(EnfSource::Synthetic(a.grid as f64));
+    }
+    let (path, offset_s) = match a.enf.rsplit_once(':') {
+        Some((p, s)) if s.parse::<f64>().is_ok() => (PathBuf::from(p), s.parse::<f64>()?),
+        _ => (PathBuf::from(&a.enf), 0.0),
+    };
+    Ok(EnfSource::File {
+        path,
+        offset_s,
+        index_step_s: a.enf_step,
+    })
+}
+
+impl SimulateArgs {
+    /// The recipe these flags ask for.
+    pub fn recipe(&self) -> Result<Recipe> {
+        let a = self;
+        let format = a
+            .events
+            .format_for(&a.output, Some(OutputFormat::Aedat4(a.events.compression)))?;
+        let enf = enf_source(a)?;
+        if let EnfSource::Synthetic(grid) = enf {
+            if grid != 50.0 && grid != 60.0 {
+                bail!("--grid must be 50 or 60");
+            }
+        }
+        Ok(Recipe {
+            config: config(a)?,
+            enf,
+            start: a.start.clone(),
+            output: a.output.clone(),
+            format,
+            cameras: a.video.cameras()?,
+            mp4: a.video.mp4,
+            reference_dir: a.reference_dir.clone(),
+        })
+    }
+}
+
+/// Search flags (`match`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct MatchArgs {
+    /// Candidates to list.
+    #[arg(long, default_value_t = 5)]
+    pub top: usize,
+    /// Check a claimed start time (e.g. 2022-08-17T16:10:00+08:00): its score, rank and
+    /// significance.
+    #[arg(long)]
+    pub verify: Option<String>,
+    /// Ranking score: `combined` (shape and level) or `cc` (shape only, robust to a bias).
+    #[arg(long, default_value = "combined", value_parser = one_of::<eenf_dsp::matching::Score>(&eenf_dsp::matching::Score::NAMES))]
+    pub score: eenf_dsp::matching::Score,
+    /// A candidate is a match when its p-value is below this.
+    #[arg(long, default_value_t = eenf_dsp::matching::DEFAULT_ALPHA)]
+    pub alpha: f64,
+    /// UTC offset of local times in WAV names.
+    #[arg(long, default_value = "+00:00", allow_hyphen_values = true)]
+    pub tz: String,
+}
+
+impl MatchArgs {
+    /// What the search asks for.
+    pub fn query(&self) -> crate::reference::MatchQuery {
+        crate::reference::MatchQuery {
+            top: self.top,
+            score: self.score,
+            verify: self.verify.clone(),
+            alpha: self.alpha,
+        }
+    }
 }

@@ -1,0 +1,706 @@
+//! `eenf._eenf`: the native half of the Python package `eenf`.
+//!
+//! A thin layer: each function turns Python values into the library's types, calls the
+//! library with the GIL released, and turns the result into numpy arrays, a `Trace` or a dict
+//! (as JSON text, which `eenf/__init__.py` loads). Keyword arguments reach here as the
+//! command line's flags (`window=8` → `--window 8`) and are parsed by the same option sets
+//! (`eenf::args`) as the `eenf` command, so names, defaults, checks and messages are the CLI's.
+//! The friendly signatures, structured arrays and plots live in `python/eenf/__init__.py`.
+
+#![forbid(unsafe_code)]
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+use clap::{Args as ClapArgs, FromArgMatches};
+use eenf::args::{
+    AudioArgs, EventOutputArgs, InputArgs, MatchArgs, MethodArgs, SimulateArgs, TrackerArgs,
+    VideoMethodArgs,
+};
+use eenf::audio::Sound;
+use eenf::extract::{Nominal, Recording};
+use eenf::progress::Progress;
+use eenf::trace::Trace;
+use eenf_events::{EventBatch, EventReader};
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::{PyStopIteration, PyValueError};
+use pyo3::prelude::*;
+
+/// Bytes per event record: `t` int64, `x` uint16, `y` uint16, `p` int8, packed (the dtype
+/// `eenf.EVENT_DTYPE` views them as).
+const RECORD: usize = 13;
+
+/// An error of the library as a Python exception: `OSError` (the subclass Python picks for
+/// the OS error's kind, e.g. `FileNotFoundError`) when a file could not be read or written,
+/// `ValueError` for bad data or parameters. The message is the CLI's.
+fn py_err(e: anyhow::Error) -> PyErr {
+    let msg = format!("{e:#}");
+    for cause in e.chain() {
+        let kind = match cause.downcast_ref::<eenf_events::EventError>() {
+            Some(eenf_events::EventError::Io { error, .. }) => Some(error.kind()),
+            _ => cause.downcast_ref::<std::io::Error>().map(|e| e.kind()),
+        };
+        if let Some(kind) = kind {
+            return PyErr::from(std::io::Error::new(kind, msg));
+        }
+    }
+    PyValueError::new_err(msg)
+}
+
+fn events_err(e: eenf_events::EventError) -> PyErr {
+    py_err(e.into())
+}
+
+/// Parses keyword arguments (already turned into flags) with one of the CLI's option sets.
+fn parse<T: ClapArgs + FromArgMatches>(what: &'static str, argv: Vec<String>) -> PyResult<T> {
+    let cmd = T::augment_args(clap::Command::new(what).no_binary_name(true));
+    let bad = |e: clap::Error| {
+        let text = e.render().to_string();
+        let line = text.lines().next().unwrap_or("bad arguments").trim();
+        PyValueError::new_err(format!(
+            "{what}: {}",
+            line.strip_prefix("error: ").unwrap_or(line)
+        ))
+    };
+    let m = cmd.try_get_matches_from(argv).map_err(bad)?;
+    T::from_arg_matches(&m).map_err(bad)
+}
+
+/// The option set behind `what`.
+fn option_set(what: &str) -> PyResult<clap::Command> {
+    let c = clap::Command::new("eenf");
+    Ok(match what {
+        "input" => InputArgs::augment_args(c),
+        "extract" => MethodArgs::augment_args(c),
+        "reference" => TrackerArgs::augment_args(AudioArgs::augment_args(c)),
+        "video" => VideoMethodArgs::augment_args(c),
+        "simulate" => SimulateArgs::augment_args(c),
+        "match" => MatchArgs::augment_args(c),
+        "write" => EventOutputArgs::augment_args(c),
+        _ => return Err(PyValueError::new_err(format!("no option set {what:?}"))),
+    })
+}
+
+/// One keyword argument: name, default, help, choices.
+type OptionDoc = (String, Option<String>, String, Vec<String>);
+
+/// The keyword arguments of an option set: (name, default, help, choices) each, for the
+/// docstrings and `help()`.
+#[pyfunction]
+fn options(what: &str) -> PyResult<Vec<OptionDoc>> {
+    let cmd = option_set(what)?;
+    Ok(cmd
+        .get_arguments()
+        .filter_map(|a| {
+            let long = a.get_long()?;
+            if long == "help" {
+                return None;
+            }
+            let default = a
+                .get_default_values()
+                .first()
+                .map(|v| v.to_string_lossy().into_owned());
+            let help = a
+                .get_long_help()
+                .or(a.get_help())
+                .map(|h| h.to_string())
+                .unwrap_or_default();
+            let choices = a
+                .get_possible_values()
+                .iter()
+                .map(|v| v.get_name().to_string())
+                .collect();
+            Some((long.replace('-', "_"), default, help, choices))
+        })
+        .collect())
+}
+
+/// Packs events `range` of a batch into 13-byte records (see [`RECORD`]).
+fn pack(b: &EventBatch, range: std::ops::Range<usize>, out: &mut Vec<u8>) {
+    let start = out.len();
+    out.resize(start + range.len() * RECORD, 0);
+    let dst = &mut out[start..];
+    for (rec, i) in dst.chunks_exact_mut(RECORD).zip(range) {
+        rec[..8].copy_from_slice(&b.t[i].to_le_bytes());
+        rec[8..10].copy_from_slice(&b.x[i].to_le_bytes());
+        rec[10..12].copy_from_slice(&b.y[i].to_le_bytes());
+        rec[12] = b.p[i] as u8;
+    }
+}
+
+/// The events of a batch with `lo <= t < hi` (a batch is in time order).
+fn within(b: &EventBatch, lo: i64, hi: i64) -> std::ops::Range<usize> {
+    let a = b.t.partition_point(|&t| t < lo);
+    let z = b.t.partition_point(|&t| t < hi);
+    a..z.max(a)
+}
+
+/// Why a stream ended early, as the warning the CLI prints.
+fn damage_warning(r: &dyn EventReader) -> Option<String> {
+    r.damage().map(|d| d.to_string())
+}
+
+/// Reads the events of `path` with `start_s <= t - t0 < end_s` (seconds from the first
+/// event) into packed records, with the warnings met (damage). The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (path, start_s=None, end_s=None, argv=Vec::new()))]
+fn read_events<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    start_s: Option<f64>,
+    end_s: Option<f64>,
+    argv: Vec<String>,
+) -> PyResult<(Bound<'py, PyArray1<u8>>, Option<String>)> {
+    let input: InputArgs = parse("read_events", argv)?;
+    let (bytes, warning) = py.detach(|| -> PyResult<(Vec<u8>, Option<String>)> {
+        let mut r = eenf_events::open_with(&path, &input.options()).map_err(events_err)?;
+        let mut out = Vec::new();
+        if let Some(n) = r.info().event_count {
+            // a hint only: bounded, never trusted for the whole file
+            out.reserve((n.min(1 << 24) as usize) * RECORD);
+        }
+        let mut t0 = None;
+        while let Some(b) = r.next_batch().map_err(events_err)? {
+            if b.is_empty() {
+                continue;
+            }
+            let first = *t0.get_or_insert(b.t[0]);
+            let us = |s: f64| first.saturating_add((s * 1e6).round().clamp(-9e18, 9e18) as i64);
+            let (lo, hi) = (start_s.map_or(i64::MIN, us), end_s.map_or(i64::MAX, us));
+            pack(&b, within(&b, lo, hi), &mut out);
+            if b.t[b.len() - 1] >= hi {
+                break;
+            }
+        }
+        Ok((out, damage_warning(r.as_ref())))
+    })?;
+    Ok((PyArray1::from_vec(py, bytes), warning))
+}
+
+/// Streams the events of a file in batches of packed records (`eenf.iter_events`).
+#[pyclass(module = "eenf._eenf")]
+struct EventIterator {
+    reader: Mutex<Box<dyn EventReader>>,
+    pending: Mutex<(EventBatch, usize)>,
+    batch: usize,
+    warned: Mutex<bool>,
+}
+
+#[pymethods]
+impl EventIterator {
+    #[new]
+    #[pyo3(signature = (path, batch=1_000_000, argv=Vec::new()))]
+    fn new(py: Python<'_>, path: PathBuf, batch: usize, argv: Vec<String>) -> PyResult<Self> {
+        if batch == 0 {
+            return Err(PyValueError::new_err("batch must be at least 1"));
+        }
+        let input: InputArgs = parse("iter_events", argv)?;
+        let reader = py
+            .detach(|| eenf_events::open_with(&path, &input.options()))
+            .map_err(events_err)?;
+        Ok(EventIterator {
+            reader: Mutex::new(reader),
+            pending: Mutex::new((EventBatch::default(), 0)),
+            batch,
+            warned: Mutex::new(false),
+        })
+    }
+
+    /// The next records (at most `batch` events), with the warning met when the stream ended
+    /// early; `StopIteration` at the end.
+    fn next<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<u8>>, Option<String>)> {
+        let (bytes, warning) = py.detach(|| -> PyResult<(Vec<u8>, Option<String>)> {
+            let mut reader = self.reader.lock().unwrap_or_else(|p| p.into_inner());
+            let mut pending = self.pending.lock().unwrap_or_else(|p| p.into_inner());
+            let mut out = Vec::with_capacity(self.batch.min(1 << 20) * RECORD);
+            while out.len() < self.batch * RECORD {
+                let (b, at) = &mut *pending;
+                if *at >= b.len() {
+                    match reader.next_batch().map_err(events_err)? {
+                        Some(next) => *pending = (next, 0),
+                        None => break,
+                    }
+                    continue;
+                }
+                let take = (self.batch - out.len() / RECORD).min(b.len() - *at);
+                pack(b, *at..*at + take, &mut out);
+                *at += take;
+            }
+            let mut warned = self.warned.lock().unwrap_or_else(|p| p.into_inner());
+            let warning = match (out.is_empty() || reader.damage().is_some(), *warned) {
+                (true, false) => damage_warning(reader.as_ref()),
+                _ => None,
+            };
+            *warned |= warning.is_some();
+            Ok((out, warning))
+        })?;
+        if bytes.is_empty() && warning.is_none() {
+            return Err(PyStopIteration::new_err(()));
+        }
+        Ok((PyArray1::from_vec(py, bytes), warning))
+    }
+
+    /// What the file's header says (as `info()`'s first part), as JSON text.
+    fn header(&self) -> String {
+        let r = self.reader.lock().unwrap_or_else(|p| p.into_inner());
+        let i = r.info();
+        serde_json::json!({"format": i.format, "codec": i.codec, "width": i.width,
+            "height": i.height, "event_count": i.event_count, "cameras": i.cameras,
+            "notes": i.notes})
+        .to_string()
+    }
+}
+
+/// `eenf info --json` of a file, as JSON text. The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (path, argv=Vec::new()))]
+fn info(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<String> {
+    let input: InputArgs = parse("info", argv)?;
+    py.detach(|| {
+        let found = eenf::inspect::inspect(&path, &input.options())?;
+        Ok(found.to_json(&path).to_string())
+    })
+    .map_err(py_err)
+}
+
+/// Events as columns (checked: lengths, order, addresses) in the library's batch.
+fn batch_of(
+    t: PyReadonlyArray1<'_, i64>,
+    x: PyReadonlyArray1<'_, u16>,
+    y: PyReadonlyArray1<'_, u16>,
+    p: PyReadonlyArray1<'_, bool>,
+) -> PyResult<EventBatch> {
+    let col = |e: numpy::AsSliceError| PyValueError::new_err(format!("event columns: {e}"));
+    Ok(EventBatch {
+        t: t.as_slice().map_err(col)?.to_vec(),
+        x: x.as_slice().map_err(col)?.to_vec(),
+        y: y.as_slice().map_err(col)?.to_vec(),
+        p: p.as_slice().map_err(col)?.to_vec(),
+    })
+}
+
+/// An ENF trace: the library's one trace type (`eenf.Trace` wraps it).
+#[pyclass(name = "NativeTrace", module = "eenf._eenf", frozen)]
+struct PyTrace(Arc<Trace>);
+
+#[pymethods]
+impl PyTrace {
+    /// Seconds from the recording's start of each estimate.
+    #[getter]
+    fn time_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.0.time_s)
+    }
+
+    /// ENF estimates, Hz (NaN where none).
+    #[getter]
+    fn enf_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.0.enf_hz)
+    }
+
+    /// Each estimate's line strength over its noise, dB (empty when not measured).
+    #[getter]
+    fn snr_db<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.0.snr_db)
+    }
+
+    /// Per-harmonic parts: (harmonic m, band centre Hz, ENF Hz, line strength dB) each.
+    #[allow(clippy::type_complexity)]
+    fn harmonic_parts<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> Vec<(
+        usize,
+        f64,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+    )> {
+        self.0
+            .harmonics
+            .iter()
+            .map(|h| {
+                (
+                    h.harmonic,
+                    h.center_hz,
+                    PyArray1::from_slice(py, &h.enf_hz),
+                    PyArray1::from_slice(py, &h.snr_db),
+                )
+            })
+            .collect()
+    }
+
+    /// The JSON form (`eenf extract --json`), as text.
+    fn to_json(&self) -> PyResult<String> {
+        let mut out = Vec::new();
+        self.0.write_json(&mut out).map_err(py_err)?;
+        String::from_utf8(out).map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
+    /// The CSV form (`time_s,enf_hz`, …), as text.
+    fn to_csv(&self) -> PyResult<String> {
+        let mut out = Vec::new();
+        self.0.write_csv(&mut out).map_err(py_err)?;
+        String::from_utf8(out).map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
+    /// Writes the trace to `path` whole or not at all: JSON when it ends in `.json`, else CSV.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let t = self.0.clone();
+        py.detach(|| eenf::output::write_atomic(&path, |w| t.write_for(&path, w)))
+            .map_err(py_err)
+    }
+
+    /// Reads a trace file: eenf JSON, a `time_s,enf_hz` CSV, or an `index,value` CSV with a
+    /// value every `index_step` s.
+    #[staticmethod]
+    #[pyo3(signature = (path, index_step=None))]
+    fn read(py: Python<'_>, path: PathBuf, index_step: Option<f64>) -> PyResult<Self> {
+        if index_step.is_some_and(|s| s.is_nan() || s <= 0.0) {
+            return Err(PyValueError::new_err("index_step must be positive"));
+        }
+        py.detach(|| Trace::read(&path, index_step))
+            .map(|t| PyTrace(Arc::new(t)))
+            .map_err(py_err)
+    }
+
+    /// A trace of `enf_hz` every `step_s` seconds from 0.
+    #[staticmethod]
+    fn from_values(step_s: f64, enf_hz: PyReadonlyArray1<'_, f64>) -> PyResult<Self> {
+        if step_s.is_nan() || step_s <= 0.0 {
+            return Err(PyValueError::new_err("step_s must be positive"));
+        }
+        let v = enf_hz
+            .as_slice()
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(PyTrace(Arc::new(Trace::new(step_s, v.to_vec()))))
+    }
+}
+
+fn traced(r: anyhow::Result<Trace>) -> PyResult<PyTrace> {
+    r.map(|t| PyTrace(Arc::new(t))).map_err(py_err)
+}
+
+/// E-ENF from an event file (`eenf extract`). The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (path, argv=Vec::new()))]
+fn extract(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<PyTrace> {
+    let m: MethodArgs = parse("extract", argv)?;
+    let opts = m.options().map_err(py_err)?;
+    traced(py.detach(|| eenf::extract::extract(&Recording::File(path), &opts, &Progress::hidden())))
+}
+
+/// E-ENF from events in memory (columns; `name` names them in messages and in the trace).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (t, x, y, p, width, height, name, argv=Vec::new()))]
+fn extract_events(
+    py: Python<'_>,
+    t: PyReadonlyArray1<'_, i64>,
+    x: PyReadonlyArray1<'_, u16>,
+    y: PyReadonlyArray1<'_, u16>,
+    p: PyReadonlyArray1<'_, bool>,
+    width: u16,
+    height: u16,
+    name: PathBuf,
+    argv: Vec<String>,
+) -> PyResult<PyTrace> {
+    let m: MethodArgs = parse("extract", argv)?;
+    let opts = m.options().map_err(py_err)?;
+    let events = Arc::new(batch_of(t, x, y, p)?);
+    let rec = Recording::Memory {
+        name,
+        events,
+        width,
+        height,
+    };
+    traced(py.detach(|| eenf::extract::extract(&rec, &opts, &Progress::hidden())))
+}
+
+/// The ENF of a sound file (`eenf reference`). The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (path, argv=Vec::new()))]
+fn reference(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<PyTrace> {
+    let (audio, tracker) = parse::<ReferenceArgs>("reference", argv)?.split();
+    let params = tracker.params().map_err(py_err)?;
+    traced(py.detach(|| {
+        eenf::reference::sound_trace(
+            &Sound::File(&path),
+            &audio.options(),
+            audio.harmonics as usize,
+            tracker.nominal,
+            &params,
+        )
+    }))
+}
+
+/// The ENF of samples in memory: `interleaved` frames of `channels` channels at `fs` Hz.
+#[pyfunction]
+#[pyo3(signature = (interleaved, channels, fs, name, argv=Vec::new()))]
+fn reference_samples(
+    py: Python<'_>,
+    interleaved: PyReadonlyArray1<'_, f32>,
+    channels: usize,
+    fs: f64,
+    name: PathBuf,
+    argv: Vec<String>,
+) -> PyResult<PyTrace> {
+    let (audio, tracker) = parse::<ReferenceArgs>("reference", argv)?.split();
+    let params = tracker.params().map_err(py_err)?;
+    let samples = interleaved
+        .as_slice()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?
+        .to_vec();
+    traced(py.detach(|| {
+        let sound = Sound::Samples {
+            name: &name,
+            interleaved: &samples,
+            channels,
+            fs,
+        };
+        eenf::reference::sound_trace(
+            &sound,
+            &audio.options(),
+            audio.harmonics as usize,
+            tracker.nominal,
+            &params,
+        )
+    }))
+}
+
+/// `reference`'s two option sets together.
+#[derive(clap::Args)]
+struct ReferenceArgs {
+    #[command(flatten)]
+    audio: AudioArgs,
+    #[command(flatten)]
+    tracker: TrackerArgs,
+}
+
+impl ReferenceArgs {
+    fn split(self) -> (AudioArgs, TrackerArgs) {
+        (self.audio, self.tracker)
+    }
+}
+
+/// V-ENF from a video (`eenf video`). The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (path, argv=Vec::new()))]
+fn video(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<PyTrace> {
+    let m: VideoMethodArgs = parse("video", argv)?;
+    let opts = m.options().map_err(py_err)?;
+    traced(py.detach(|| eenf::video::trace_video(&path, &opts, &Progress::hidden())))
+}
+
+/// A reference for `compare`: a trace at hand, or a file (trace, WAV, folder of hourly WAVs).
+#[derive(FromPyObject)]
+enum ReferenceIn<'py> {
+    Trace(PyRef<'py, PyTrace>),
+    Path(PathBuf),
+}
+
+/// `eenf compare`: the agreement of an estimate with its reference, as JSON text with the
+/// aligned values. The GIL is released.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (estimate, name, reference, offset_s=0.0, index_step=eenf::trace::INDEX_STEP_S, nominal="auto", peak=None))]
+fn compare(
+    py: Python<'_>,
+    estimate: PyRef<'_, PyTrace>,
+    name: PathBuf,
+    reference: ReferenceIn<'_>,
+    offset_s: f64,
+    index_step: f64,
+    nominal: &str,
+    peak: Option<&str>,
+) -> PyResult<String> {
+    if index_step.is_nan() || index_step <= 0.0 {
+        return Err(PyValueError::new_err("index_step must be positive"));
+    }
+    let nominal: Nominal = nominal.parse().map_err(PyValueError::new_err)?;
+    let est = estimate.0.clone();
+    let peak = match peak {
+        Some(p) => p.parse().map_err(PyValueError::new_err)?,
+        None => est.peak().unwrap_or(eenf_dsp::PeakMethod::Exact),
+    };
+    let params = eenf_dsp::EnfParams {
+        peak,
+        ..eenf_dsp::EnfParams::default()
+    };
+    let c = match reference {
+        ReferenceIn::Trace(r) => {
+            let r = r.0.clone();
+            py.detach(|| {
+                eenf::evaluate::compare_with(&est.time_s, &est.enf_hz, &name, &r, offset_s)
+            })
+        }
+        ReferenceIn::Path(path) => py.detach(|| {
+            eenf::evaluate::compare_trace(
+                &est, &name, &path, offset_s, index_step, nominal, &params,
+            )
+        }),
+    }
+    .map_err(py_err)?;
+    let m = c.agreement;
+    Ok(serde_json::json!({
+        "cc": m.cc, "mae_hz": m.mae_hz, "rmse_hz": m.rmse_hz, "max_err_hz": m.max_err_hz,
+        "seconds": m.n, "offset_s": offset_s, "time_s": c.time_s, "estimate": c.estimate,
+        "reference": c.reference,
+    })
+    .to_string())
+}
+
+/// `eenf match`: where a trace fits in long references, as `eenf match --json` prints it.
+/// The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (trace, name, reference, argv=Vec::new()))]
+fn match_trace(
+    py: Python<'_>,
+    trace: PyRef<'_, PyTrace>,
+    name: PathBuf,
+    reference: PathBuf,
+    argv: Vec<String>,
+) -> PyResult<String> {
+    let m: MatchArgs = parse("match", argv)?;
+    let t = trace.0.clone();
+    py.detach(|| {
+        let nominal = eenf::reference::match_grid(&t, &name)?;
+        let tz = eenf::time::tz_offset(&m.tz)?;
+        let refs =
+            eenf::reference::ReferenceSeries::load(&reference, nominal, tz, &Progress::hidden())?;
+        let query = m.query();
+        let report = eenf::reference::match_trace_in(&t, &name, &refs, &query)?;
+        Ok(report.to_json(&name, &refs, query.alpha).to_string())
+    })
+    .map_err(py_err)
+}
+
+/// `eenf simulate`: writes a recording and its truth; returns what was written, as JSON text.
+/// The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (argv=Vec::new()))]
+fn simulate(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
+    let a: SimulateArgs = parse("simulate", argv)?;
+    let recipe = a.recipe().map_err(py_err)?;
+    py.detach(|| {
+        let r = eenf::simulation::simulate_recording(&recipe, &Progress::hidden())?;
+        Ok(serde_json::json!({
+            "recording": r.sim.recording, "truth": r.sim.truth, "events": r.sim.stats.events,
+            "videos": r.videos, "references": r.references,
+            "width": r.config.width, "height": r.config.height,
+        })
+        .to_string())
+    })
+    .map_err(py_err)
+}
+
+/// Writes events (columns, checked) to `path` whole or not at all (`eenf convert`'s writers);
+/// returns the number written. The GIL is released.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (path, t, x, y, p, width, height, argv=Vec::new()))]
+fn write_events(
+    py: Python<'_>,
+    path: PathBuf,
+    t: PyReadonlyArray1<'_, i64>,
+    x: PyReadonlyArray1<'_, u16>,
+    y: PyReadonlyArray1<'_, u16>,
+    p: PyReadonlyArray1<'_, bool>,
+    width: u16,
+    height: u16,
+    argv: Vec<String>,
+) -> PyResult<u64> {
+    let out: EventOutputArgs = parse("write_events", argv)?;
+    let format = out.format_for(&path, None).map_err(py_err)?;
+    let events = batch_of(t, x, y, p)?;
+    py.detach(|| {
+        eenf_events::memory::check_events(&events, width, height, &path)?;
+        eenf::output::write_events(&path, format, width, height, |w| {
+            for i in (0..events.len()).step_by(1 << 16) {
+                let r = i..(i + (1 << 16)).min(events.len());
+                let chunk = EventBatch {
+                    t: events.t[r.clone()].to_vec(),
+                    x: events.x[r.clone()].to_vec(),
+                    y: events.y[r.clone()].to_vec(),
+                    p: events.p[r].to_vec(),
+                };
+                w.write(&chunk)?;
+            }
+            Ok(())
+        })
+    })
+    .map_err(py_err)
+}
+
+/// Unpacks records (as `read_events` returns) into columns, using both cores: for callers
+/// that want plain arrays.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn unpack<'py>(
+    py: Python<'py>,
+    records: PyReadonlyArray1<'py, u8>,
+) -> PyResult<(
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<u16>>,
+    Bound<'py, PyArray1<u16>>,
+    Bound<'py, PyArray1<bool>>,
+)> {
+    use rayon::prelude::*;
+    let bytes = records
+        .as_slice()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    if !bytes.len().is_multiple_of(RECORD) {
+        return Err(PyValueError::new_err(
+            "records: not a whole number of events",
+        ));
+    }
+    let (t, x, y, p) = py.detach(|| {
+        let n = bytes.len() / RECORD;
+        let mut t = vec![0i64; n];
+        let mut x = vec![0u16; n];
+        let mut y = vec![0u16; n];
+        let mut p = vec![false; n];
+        const CHUNK: usize = 1 << 16;
+        t.par_chunks_mut(CHUNK)
+            .zip(x.par_chunks_mut(CHUNK))
+            .zip(y.par_chunks_mut(CHUNK))
+            .zip(p.par_chunks_mut(CHUNK))
+            .zip(bytes.par_chunks(CHUNK * RECORD))
+            .for_each(|((((t, x), y), p), src)| {
+                for (i, r) in src.chunks_exact(RECORD).enumerate() {
+                    t[i] = i64::from_le_bytes(r[..8].try_into().unwrap_or_default());
+                    x[i] = u16::from_le_bytes([r[8], r[9]]);
+                    y[i] = u16::from_le_bytes([r[10], r[11]]);
+                    p[i] = r[12] != 0;
+                }
+            });
+        (t, x, y, p)
+    });
+    Ok((
+        PyArray1::from_vec(py, t),
+        PyArray1::from_vec(py, x),
+        PyArray1::from_vec(py, y),
+        PyArray1::from_vec(py, p),
+    ))
+}
+
+/// The native module.
+#[pymodule]
+fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("RECORD_BYTES", RECORD)?;
+    m.add("VERSION", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<PyTrace>()?;
+    m.add_class::<EventIterator>()?;
+    m.add_function(wrap_pyfunction!(options, m)?)?;
+    m.add_function(wrap_pyfunction!(read_events, m)?)?;
+    m.add_function(wrap_pyfunction!(info, m)?)?;
+    m.add_function(wrap_pyfunction!(extract, m)?)?;
+    m.add_function(wrap_pyfunction!(extract_events, m)?)?;
+    m.add_function(wrap_pyfunction!(reference, m)?)?;
+    m.add_function(wrap_pyfunction!(reference_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(video, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(match_trace, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(write_events, m)?)?;
+    m.add_function(wrap_pyfunction!(unpack, m)?)?;
+    Ok(())
+}

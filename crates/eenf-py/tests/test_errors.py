@@ -1,0 +1,92 @@
+"""Bad input raises a Python exception with the command line's message, and never brings the
+interpreter down."""
+
+import numpy as np
+import pytest
+
+import eenf
+
+
+def test_a_missing_file_is_an_os_error(tmp_path):
+    missing = tmp_path / "nope.aedat4"
+    for call in [eenf.read_events, eenf.info, eenf.extract, eenf.reference, eenf.Trace.read]:
+        with pytest.raises(OSError, match="nope"):
+            call(missing)
+    with pytest.raises(FileNotFoundError):
+        list(eenf.iter_events(missing))
+
+
+def test_an_unknown_or_empty_file_is_a_value_error(tmp_path):
+    (tmp_path / "empty.aedat4").write_bytes(b"")
+    (tmp_path / "junk.bin").write_bytes(b"\x00\x01garbage" * 100)
+    for name in ["empty.aedat4", "junk.bin"]:
+        with pytest.raises(ValueError, match=name):
+            eenf.read_events(tmp_path / name)
+
+
+def test_a_truncated_file_warns_and_gives_what_is_readable(sim, tmp_path):
+    data = open(sim.recording, "rb").read()
+    cut = tmp_path / "cut.aedat4"
+    cut.write_bytes(data[: len(data) * 6 // 10])
+    whole = eenf.read_events(sim.recording)
+    with pytest.warns(eenf.EenfWarning, match="truncated"):
+        part = eenf.read_events(cut)
+    assert 0 < len(part) < len(whole) and np.array_equal(part, whole[: len(part)])
+    with pytest.raises(ValueError, match="truncated"):
+        eenf.read_events(cut, strict=True)
+    with pytest.warns(eenf.EenfWarning):
+        assert len(np.concatenate(list(eenf.iter_events(cut)))) == len(part)
+    # cut inside the header: nothing to read
+    head = tmp_path / "head.aedat4"
+    head.write_bytes(data[:20])
+    with pytest.raises(ValueError, match="head.aedat4"):
+        eenf.read_events(head)
+
+
+def events(n=1000):
+    t = np.arange(n, dtype=np.int64) * 10
+    return t, (np.arange(n) % 32).astype(np.uint16), (np.arange(n) % 24).astype(np.uint16), np.ones(n, bool)
+
+
+def test_bad_event_arrays():
+    t, x, y, p = events()
+    with pytest.raises(TypeError, match="t must hold integers"):
+        eenf.extract((t.astype(float), x, y, p))
+    with pytest.raises(TypeError, match="structured array"):
+        eenf.extract(np.zeros((10, 4)))
+    with pytest.raises(TypeError, match="no field"):
+        eenf.extract(np.zeros(10, dtype=[("a", "i8"), ("x", "u2")]))
+    with pytest.raises(ValueError, match="empty"):
+        eenf.extract((t[:0], x[:0], y[:0], p[:0]))
+    with pytest.raises(ValueError, match="t has 1000 values but x has 999"):
+        eenf.extract((t, x[:-1], y, p))
+    with pytest.raises(ValueError, match="0..65535"):
+        eenf.extract((t, x.astype(np.int32) - 1, y, p))
+    unsorted = t.copy()
+    unsorted[500] = 3
+    with pytest.raises(ValueError, match="must not decrease"):
+        eenf.extract((unsorted, x, y, p))
+    with pytest.raises(ValueError, match="outside"):
+        eenf.extract((t, x, y, p), width=8)
+    with pytest.raises(ValueError, match="must not decrease"):
+        eenf.write_events("never-written.aedat4", (unsorted, x, y, p))
+
+
+def test_bad_samples_and_parameters(sim, tmp_path):
+    x = np.sin(np.arange(20000) * 0.3)
+    x[1234] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        eenf.reference(x, fs=1000)
+    with pytest.raises(TypeError, match="fs"):
+        eenf.reference(x)
+    with pytest.raises(ValueError, match="unexpected argument '--windoww'"):
+        eenf.extract(sim.recording, windoww=8)
+    with pytest.raises(ValueError, match="must be positive"):
+        eenf.extract(sim.recording, window=-1.0)
+    with pytest.raises(ValueError, match="invalid value 'nope'"):
+        eenf.extract(sim.recording, sampling="nope")
+    with pytest.raises(ValueError, match="camera 3"):
+        eenf.read_events(sim.recording, camera=3)
+    with pytest.raises(ValueError):
+        eenf.write_events(tmp_path / "a.unknown", events())
+    assert not (tmp_path / "a.unknown").exists()
