@@ -116,26 +116,25 @@ def test_the_gil_is_released_while_reading(tmp_path):
 # --- the peers, installed beside eenf in CI ---
 
 
-def test_dv_processing_events_in_and_out(sim, shared):
-    dv = peer("dv_processing")
-    want = eenf.extract(sim.recording)
-    rec = dv.io.MonoCameraRecording(sim.recording)
+def dv_events(dv, path):
+    """All events of an AEDAT4 file through dv-processing's numpy path."""
+    rec = dv.io.MonoCameraRecording(str(path))
     parts = []
     while rec.isRunning():
         b = rec.getNextEventBatch()
         if b is not None and b.size() > 0:
             parts.append(b.numpy())
-    arr = np.concatenate(parts)
+    return np.concatenate(parts)
+
+
+def test_dv_processing_events_in_and_out(sim, shared):
+    dv = peer("dv_processing")
+    want = eenf.extract(sim.recording)
+    arr = dv_events(dv, sim.recording)
     got = eenf.extract(arr, width=sim.width, height=sim.height)
     assert np.array_equal(got.enf_hz, want.enf_hz, equal_nan=True)
     for f in sorted((shared / "fixtures").rglob("*.aedat4")):
-        rec = dv.io.MonoCameraRecording(str(f))
-        parts = []
-        while rec.isRunning():
-            b = rec.getNextEventBatch()
-            if b is not None and b.size() > 0:
-                parts.append(b.numpy())
-        theirs = np.concatenate(parts)
+        theirs = dv_events(dv, f)
         ours = eenf.read_events(f)
         assert len(ours) == len(theirs), f
         for a, b in [("t", "timestamp"), ("x", "x"), ("y", "y"), ("p", "polarity")]:

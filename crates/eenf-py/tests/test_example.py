@@ -109,3 +109,22 @@ def test_help_lists_the_parameters_with_their_defaults():
         assert needle in doc, needle
     assert "channel (default mix)" in eenf.reference.__doc__
     assert "duration (default 60)" in eenf.simulate.__doc__
+
+
+def test_video_equals_the_command_line(cli, tmp_path):
+    sim = eenf.simulate(tmp_path / "v.aedat4", duration=20, video="lr", video_scale=0.25)
+    assert len(sim.videos) == 1
+    want = cli_json(cli, "video", sim.videos[0], "--json")
+    got = eenf.video(sim.videos[0])
+    assert same(want["enf_hz"], got.enf_hz)
+    c = eenf.compare(got, sim.truth)
+    assert c.seconds > 10
+
+
+def test_real_recordings_equal_the_command_line(cli, shared):
+    for name in ["jaer_MovingDarkBox.aedat", "fhaust_Tmpdiff128StereoPair-vertical-arm.aedat"]:
+        path = shared / "fixtures" / "real-flicker" / name
+        want = cli_json(cli, "extract", path, "--json")
+        got = eenf.extract(path)
+        assert same(want["enf_hz"], got.enf_hz), name
+        assert got.meta.get("camera") == want.get("camera")

@@ -71,21 +71,18 @@ fn samples_in_memory_give_the_wav_trace_and_nan_is_refused() {
     );
     let nominal = eenf::extract::Nominal::Auto;
     let want = sound_trace(&Sound::File(&wav), &audio, 1, nominal, &params).unwrap();
-    let samples = Sound::Samples {
-        name: Path::new("pcm"),
-        interleaved: &pcm,
-        channels: 1,
-        fs: fs as f64,
+    let in_memory = |pcm: &[f32]| {
+        let sound = Sound::Samples {
+            name: Path::new("pcm"),
+            interleaved: pcm,
+            channels: 1,
+            fs: fs as f64,
+        };
+        sound_trace(&sound, &audio, 1, nominal, &params)
     };
-    let got = sound_trace(&samples, &audio, 1, nominal, &params).unwrap();
+    let got = in_memory(&pcm).unwrap();
     assert!(same(&got.enf_hz, &want.enf_hz));
     pcm[777] = f32::NAN;
-    let bad = Sound::Samples {
-        name: Path::new("pcm"),
-        interleaved: &pcm,
-        channels: 1,
-        fs: fs as f64,
-    };
-    let e = sound_trace(&bad, &audio, 1, nominal, &params).unwrap_err();
+    let e = in_memory(&pcm).unwrap_err();
     assert!(format!("{e:#}").contains("sample 777"), "{e:#}");
 }
