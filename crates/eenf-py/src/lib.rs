@@ -180,10 +180,16 @@ fn read_events<'py>(
 /// Streams the events of a file in batches of packed records (`eenf.iter_events`).
 #[pyclass(module = "eenf._eenf")]
 struct EventIterator {
-    reader: Mutex<Box<dyn EventReader>>,
-    pending: Mutex<(EventBatch, usize)>,
+    state: Mutex<IterState>,
     batch: usize,
-    warned: Mutex<bool>,
+}
+
+/// The reader, the batch being handed out and how far, and whether its damage was reported.
+struct IterState {
+    reader: Box<dyn EventReader>,
+    pending: EventBatch,
+    at: usize,
+    warned: bool,
 }
 
 #[pymethods]
@@ -199,10 +205,13 @@ impl EventIterator {
             .detach(|| eenf_events::open_with(&path, &input.options()))
             .map_err(events_err)?;
         Ok(EventIterator {
-            reader: Mutex::new(reader),
-            pending: Mutex::new((EventBatch::default(), 0)),
+            state: Mutex::new(IterState {
+                reader,
+                pending: EventBatch::default(),
+                at: 0,
+                warned: false,
+            }),
             batch,
-            warned: Mutex::new(false),
         })
     }
 
@@ -210,28 +219,26 @@ impl EventIterator {
     /// early; `StopIteration` at the end.
     fn next<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<u8>>, Option<String>)> {
         let (bytes, warning) = py.detach(|| -> PyResult<(Vec<u8>, Option<String>)> {
-            let mut reader = self.reader.lock().unwrap_or_else(|p| p.into_inner());
-            let mut pending = self.pending.lock().unwrap_or_else(|p| p.into_inner());
+            let mut guard = self.state.lock().unwrap_or_else(|p| p.into_inner());
+            let st = &mut *guard;
             let mut out = Vec::with_capacity(self.batch.min(1 << 20) * RECORD);
             while out.len() < self.batch * RECORD {
-                let (b, at) = &mut *pending;
-                if *at >= b.len() {
-                    match reader.next_batch().map_err(events_err)? {
-                        Some(next) => *pending = (next, 0),
+                if st.at >= st.pending.len() {
+                    match st.reader.next_batch().map_err(events_err)? {
+                        Some(next) => (st.pending, st.at) = (next, 0),
                         None => break,
                     }
                     continue;
                 }
-                let take = (self.batch - out.len() / RECORD).min(b.len() - *at);
-                pack(b, *at..*at + take, &mut out);
-                *at += take;
+                let take = (self.batch - out.len() / RECORD).min(st.pending.len() - st.at);
+                pack(&st.pending, st.at..st.at + take, &mut out);
+                st.at += take;
             }
-            let mut warned = self.warned.lock().unwrap_or_else(|p| p.into_inner());
-            let warning = match (out.is_empty() || reader.damage().is_some(), *warned) {
-                (true, false) => damage_warning(reader.as_ref()),
+            let warning = match (out.is_empty() || st.reader.damage().is_some(), st.warned) {
+                (true, false) => damage_warning(st.reader.as_ref()),
                 _ => None,
             };
-            *warned |= warning.is_some();
+            st.warned |= warning.is_some();
             Ok((out, warning))
         })?;
         if bytes.is_empty() && warning.is_none() {
@@ -242,8 +249,8 @@ impl EventIterator {
 
     /// What the file's header says (as `info()`'s first part), as JSON text.
     fn header(&self) -> String {
-        let r = self.reader.lock().unwrap_or_else(|p| p.into_inner());
-        let i = r.info();
+        let st = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        let i = st.reader.info();
         serde_json::json!({"format": i.format, "codec": i.codec, "width": i.width,
             "height": i.height, "event_count": i.event_count, "cameras": i.cameras,
             "notes": i.notes})
@@ -630,58 +637,6 @@ fn write_events(
     .map_err(py_err)
 }
 
-/// Unpacks records (as `read_events` returns) into columns, using both cores: for callers
-/// that want plain arrays.
-#[pyfunction]
-#[allow(clippy::type_complexity)]
-fn unpack<'py>(
-    py: Python<'py>,
-    records: PyReadonlyArray1<'py, u8>,
-) -> PyResult<(
-    Bound<'py, PyArray1<i64>>,
-    Bound<'py, PyArray1<u16>>,
-    Bound<'py, PyArray1<u16>>,
-    Bound<'py, PyArray1<bool>>,
-)> {
-    use rayon::prelude::*;
-    let bytes = records
-        .as_slice()
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    if !bytes.len().is_multiple_of(RECORD) {
-        return Err(PyValueError::new_err(
-            "records: not a whole number of events",
-        ));
-    }
-    let (t, x, y, p) = py.detach(|| {
-        let n = bytes.len() / RECORD;
-        let mut t = vec![0i64; n];
-        let mut x = vec![0u16; n];
-        let mut y = vec![0u16; n];
-        let mut p = vec![false; n];
-        const CHUNK: usize = 1 << 16;
-        t.par_chunks_mut(CHUNK)
-            .zip(x.par_chunks_mut(CHUNK))
-            .zip(y.par_chunks_mut(CHUNK))
-            .zip(p.par_chunks_mut(CHUNK))
-            .zip(bytes.par_chunks(CHUNK * RECORD))
-            .for_each(|((((t, x), y), p), src)| {
-                for (i, r) in src.chunks_exact(RECORD).enumerate() {
-                    t[i] = i64::from_le_bytes(r[..8].try_into().unwrap_or_default());
-                    x[i] = u16::from_le_bytes([r[8], r[9]]);
-                    y[i] = u16::from_le_bytes([r[10], r[11]]);
-                    p[i] = r[12] != 0;
-                }
-            });
-        (t, x, y, p)
-    });
-    Ok((
-        PyArray1::from_vec(py, t),
-        PyArray1::from_vec(py, x),
-        PyArray1::from_vec(py, y),
-        PyArray1::from_vec(py, p),
-    ))
-}
-
 /// The native module.
 #[pymodule]
 fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -701,6 +656,5 @@ fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(match_trace, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(write_events, m)?)?;
-    m.add_function(wrap_pyfunction!(unpack, m)?)?;
     Ok(())
 }
