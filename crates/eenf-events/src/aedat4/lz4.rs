@@ -1,7 +1,8 @@
 //! The LZ4 frame format, decoded block by block straight into a reused output buffer
-//! (`lz4_flex`'s streaming decoder copies every byte once more through its own buffer).
-//! Blocks without history go through liblz4's bounds-checked `LZ4_decompress_safe` (the `lz4`
-//! crate); linked blocks, which need the blocks before as a dictionary, through `lz4_flex`.
+//! (streaming decoders copy every byte once more through their own buffer). Every block goes
+//! through liblz4's bounds-checked `LZ4_decompress_safe_usingDict` (the `lz4-sys` crate): linked
+//! blocks (dv-processing writes 64 KiB linked blocks) with the blocks before them in the same
+//! buffer as their history, which is liblz4's fast path; independent blocks with none.
 
 /// The LZ4 frame magic number.
 const MAGIC: u32 = 0x184D_2204;
@@ -77,26 +78,15 @@ pub(crate) fn decode_frames(input: &[u8], out: &mut Vec<u8>) -> Result<usize, St
                 }
                 out[n..n + len].copy_from_slice(block);
                 n += len;
-            } else if independent || n == frame_start {
-                // no history to refer to: liblz4's bounds-checked LZ4_decompress_safe, about
-                // 1.3x lz4_flex's checked decoder on event packets
-                let k = lz4::block::decompress_to_buffer(
-                    block,
-                    Some(max_block as i32),
-                    &mut out[n..n + max_block],
-                )
-                .map_err(|e| format!("LZ4 decompression failed: {e}"))?;
-                n += k;
             } else {
                 // linked blocks (dv-processing's default) refer back into the blocks before
-                let (before, after) = out.split_at_mut(n);
-                let dict_from = n.saturating_sub(WINDOW).max(frame_start);
-                let k = lz4_flex::block::decompress_into_with_dict(
-                    block,
-                    &mut after[..max_block],
-                    &before[dict_from..],
-                )
-                .map_err(|e| format!("LZ4 decompression failed: {e}"))?;
+                let dict_from = if independent {
+                    n
+                } else {
+                    n.saturating_sub(WINDOW).max(frame_start)
+                };
+                let k = liblz4::decompress_block(block, out, dict_from, n, max_block)
+                    .ok_or("LZ4 decompression failed: corrupt block")?;
                 n += k;
             }
         }
@@ -108,6 +98,62 @@ pub(crate) fn decode_frames(input: &[u8], out: &mut Vec<u8>) -> Result<usize, St
         }
     }
     Ok(n)
+}
+
+/// The one call into liblz4. Its `_safe` decoders are written to be safe on any input: they
+/// never read outside `src` or the dictionary and never write past `dst + dstCapacity`
+/// (lz4.h, "LZ4_decompress_safe"); a corrupt block returns a negative number.
+#[allow(unsafe_code)]
+mod liblz4 {
+    use std::os::raw::{c_char, c_int};
+
+    // liblz4 is built and linked by lz4-sys; this function of its stable API (lz4.h,
+    // LZ4LIB_API since 1.7) is not among the ones lz4-sys declares
+    use lz4_sys as _;
+    unsafe extern "C" {
+        fn LZ4_decompress_safe_usingDict(
+            src: *const c_char,
+            dst: *mut c_char,
+            src_size: c_int,
+            dst_capacity: c_int,
+            dict_start: *const c_char,
+            dict_size: c_int,
+        ) -> c_int;
+    }
+
+    /// Decodes the LZ4 block `src` into `buf[at..at + cap]`, with `buf[dict_from..at]` as the
+    /// history its matches may refer to; returns the bytes written, `None` on a corrupt block.
+    pub(super) fn decompress_block(
+        src: &[u8],
+        buf: &mut [u8],
+        dict_from: usize,
+        at: usize,
+        cap: usize,
+    ) -> Option<usize> {
+        if dict_from > at || at.checked_add(cap)? > buf.len() {
+            return None;
+        }
+        let src_size = c_int::try_from(src.len()).ok()?;
+        let dst_capacity = c_int::try_from(cap).ok()?;
+        let dict_size = c_int::try_from(at - dict_from).ok()?;
+        let base = buf.as_mut_ptr();
+        // SAFETY: `src` is readable for `src_size` bytes; `base + at` is writable for
+        // `dst_capacity` bytes and `base + dict_from` readable for `dict_size` bytes, all inside
+        // `buf` (checked above), which nothing else touches during the call; the dictionary
+        // ends where the output starts, so they do not overlap. The `_safe` decoder stays
+        // inside these ranges whatever `src` holds.
+        let k = unsafe {
+            LZ4_decompress_safe_usingDict(
+                src.as_ptr().cast(),
+                base.add(at).cast(),
+                src_size,
+                dst_capacity,
+                base.add(dict_from).cast(),
+                dict_size,
+            )
+        };
+        usize::try_from(k).ok()
+    }
 }
 
 #[cfg(test)]
@@ -159,5 +205,29 @@ mod tests {
         let mut bad = f.clone();
         bad[0] ^= 1;
         assert!(decode_frames(&bad, &mut out).is_err());
+    }
+
+    #[test]
+    fn flipped_bytes_in_linked_blocks_never_read_outside() {
+        // every byte of a linked multi-block frame flipped in turn: liblz4's checked decoder
+        // must return an error or some output, never crash or run past its buffers
+        let data: Vec<u8> = (0..150_000u32)
+            .map(|i| ((i / 5) % 241) as u8 ^ (i % 7) as u8)
+            .collect();
+        let f = frame(&data, true);
+        let mut out = Vec::new();
+        let step = (f.len() / 2000).max(1);
+        for at in (0..f.len()).step_by(step) {
+            for flip in [0x01u8, 0x80, 0xFF] {
+                let mut bad = f.clone();
+                bad[at] ^= flip;
+                if let Ok(n) = decode_frames(&bad, &mut out) {
+                    assert!(n <= out.len());
+                }
+            }
+        }
+        // and the undamaged frame still decodes into the same (now dirty) buffer
+        let n = decode_frames(&f, &mut out).unwrap();
+        assert_eq!(&out[..n], &data[..]);
     }
 }
