@@ -79,7 +79,8 @@ pub(crate) fn decode_frames(input: &[u8], out: &mut Vec<u8>) -> Result<usize, St
                 out[n..n + len].copy_from_slice(block);
                 n += len;
             } else {
-                // linked blocks (dv-processing's default) refer back into the blocks before
+                // linked blocks (dv-processing's default) may refer back up to 64 KiB into the
+                // blocks of their frame before them; independent ones to nothing
                 let dict_from = if independent {
                     n
                 } else {

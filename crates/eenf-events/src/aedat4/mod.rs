@@ -173,6 +173,10 @@ thread_local! {
     static SCRATCH: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
+/// A thread keeps its buffer up to this size (packets decompress to a few hundred KiB); one
+/// grown by an outsized packet is freed, so that a thread does not hold it for the process's life.
+const SCRATCH_KEPT: usize = 16 << 20;
+
 /// Decompresses one packet body into `scratch` (reused between packets, so it is zero-filled
 /// only when it grows) and returns the decompressed bytes. The output size is bounded so that a
 /// corrupt frame cannot make us allocate without limit.
@@ -484,8 +488,12 @@ impl Aedat4Reader {
                     .par_iter()
                     .map(|slot| {
                         let batch = SCRATCH.with_borrow_mut(|scratch| {
-                            decompress(codec, &slot.body[..slot.size], scratch)
-                                .and_then(decode_event_packet)
+                            let batch = decompress(codec, &slot.body[..slot.size], scratch)
+                                .and_then(decode_event_packet);
+                            if scratch.capacity() > SCRATCH_KEPT {
+                                *scratch = Vec::new();
+                            }
+                            batch
                         });
                         (slot.at, batch)
                     })
