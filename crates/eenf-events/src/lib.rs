@@ -22,6 +22,7 @@
 
 pub mod aedat4;
 mod batch;
+pub mod contain;
 mod error;
 mod guard;
 pub mod jaer;
@@ -37,6 +38,7 @@ use std::path::Path;
 
 pub use aedat4::{Aedat4Reader, Aedat4Writer, Compression};
 pub use batch::EventBatch;
+pub use contain::contain;
 pub use error::{EventError, Result};
 pub use guard::{Damage, DamageKind, DEFAULT_MAX_GAP_US};
 pub use memory::open_events;

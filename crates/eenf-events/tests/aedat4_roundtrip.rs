@@ -272,3 +272,83 @@ fn a_wild_timestamp_ends_the_stream_where_it_is() {
     assert_eq!(StreamStats::scan(r.as_mut()).unwrap().events, 2);
     assert_eq!(r.damage().unwrap().kind, DamageKind::TimeJump);
 }
+
+/// `events` written as ZSTD without an index, then `packet` (a compressed body) appended as a
+/// further packet of the event stream.
+fn with_extra_packet(
+    path: &std::path::Path,
+    codec: Compression,
+    events: &EventBatch,
+    packet: &[u8],
+) {
+    write(path, codec, events);
+    let mut bytes = std::fs::read(path).unwrap();
+    let hlen = u32::from_le_bytes(bytes[14..18].try_into().unwrap()) as usize;
+    let table_pos = find_table_pos(&bytes, hlen);
+    bytes.truncate(table_pos as usize);
+    let needle = table_pos.to_le_bytes();
+    let at = bytes[18..18 + hlen]
+        .windows(8)
+        .position(|w| w == needle)
+        .unwrap();
+    bytes[18 + at..18 + at + 8].copy_from_slice(&(-1i64).to_le_bytes());
+    bytes.extend_from_slice(&0i32.to_le_bytes());
+    bytes.extend_from_slice(&(packet.len() as i32).to_le_bytes());
+    bytes.extend_from_slice(packet);
+    std::fs::write(path, &bytes).unwrap();
+}
+
+#[test]
+fn a_packet_that_expands_past_the_limit_is_damage_after_the_events_before_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let events = sample(3_000);
+    let zeros = vec![0u8; (64 << 20) + 4096];
+    // zstd with the size in its frame header, zstd streamed without it, and LZ4
+    let zstd_sized = zstd::bulk::compress(&zeros, 1).unwrap();
+    let mut zstd_streamed = Vec::new();
+    {
+        let mut enc = zstd::stream::write::Encoder::new(&mut zstd_streamed, 1).unwrap();
+        enc.include_contentsize(false).unwrap();
+        enc.write_all(&zeros).unwrap();
+        enc.finish().unwrap();
+    }
+    let mut lz4 = lz4_flex::frame::FrameEncoder::new(Vec::new());
+    lz4.write_all(&zeros).unwrap();
+    let lz4 = lz4.finish().unwrap();
+    for (name, codec, packet) in [
+        ("zstd_sized", Compression::Zstd, zstd_sized),
+        ("zstd_streamed", Compression::Zstd, zstd_streamed),
+        ("lz4", Compression::Lz4, lz4),
+    ] {
+        let path = dir.path().join(format!("{name}.aedat4"));
+        with_extra_packet(&path, codec, &events, &packet);
+        let mut r = open(&path).unwrap();
+        let mut all = EventBatch::default();
+        while let Some(b) = r.next_batch().unwrap() {
+            all.extend_from(&b);
+        }
+        assert_eq!(all, events, "{name}: the events before the packet");
+        let err = r.damage().expect("the outsized packet is damage").to_string();
+        assert!(err.contains("64 MiB limit"), "{name}: {err}");
+        assert!(err.contains(&path.display().to_string()), "{name}: {err}");
+    }
+}
+
+#[test]
+fn a_large_honest_packet_is_read_whole_in_bounded_batches() {
+    let dir = tempfile::tempdir().unwrap();
+    let events = sample(1_500_000);
+    let path = dir.path().join("big.aedat4");
+    let mut w = Aedat4Writer::create(&path, Compression::Lz4, 640, 480)
+        .unwrap()
+        .with_packet_events(1_500_000);
+    w.write(&events).unwrap();
+    w.finish().unwrap();
+    let mut r = open(&path).unwrap();
+    let mut all = EventBatch::default();
+    while let Some(b) = r.next_batch().unwrap() {
+        assert!(b.len() <= 1 << 18, "a batch of {} events", b.len());
+        all.extend_from(&b);
+    }
+    assert_eq!(all, events);
+}

@@ -127,14 +127,31 @@ impl Sink {
 /// read (video containers, other codecs). A damaged packet is skipped; a recording with no
 /// sound is an error.
 pub fn read_audio(path: &Path, opts: &AudioOptions) -> Result<Audio> {
-    let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
-    match read_symphonia(file, path, opts) {
+    let mut file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
+    if is_matroska(&mut file) {
+        // Symphonia's Matroska reader panics on cut-short files and allocates whatever a lace
+        // size says (0.5.5): MKV and WebM go to ffmpeg, which reads them robustly
+        return read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {e}", path.display()));
+    }
+    // a panic inside Symphonia (damaged data it does not check) is the file's error, and
+    // ffmpeg is asked next as for a format Symphonia does not read
+    let symphonia = eenf_events::contain(|| read_symphonia(file, path, opts))
+        .unwrap_or_else(|why| Err(Unreadable::Format(why)));
+    match symphonia {
         Ok(a) => Ok(a),
         Err(Unreadable::Format(why)) => {
             read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {why}; {e}", path.display()))
         }
         Err(Unreadable::Other(e)) => Err(e),
     }
+}
+
+/// Whether `file` starts with the EBML magic of Matroska and WebM; the file is left at its start.
+fn is_matroska(file: &mut std::fs::File) -> bool {
+    use std::io::{Seek, SeekFrom};
+    let mut head = [0u8; 4];
+    let matroska = file.read_exact(&mut head).is_ok() && head == [0x1A, 0x45, 0xDF, 0xA3];
+    file.seek(SeekFrom::Start(0)).is_ok() && matroska
 }
 
 /// A recording's sound: a file (any format [`read_audio`] reads), or samples already in
@@ -263,6 +280,12 @@ fn read_symphonia(
             Unreadable::Format(format!("its audio codec is not one eenf decodes ({e})"))
         })?;
     let fs = params.sample_rate.unwrap_or(0) as f64;
+    if fs <= 0.0 {
+        return Err(Unreadable::Other(anyhow!(
+            "{}: its header gives a sample rate of 0 Hz",
+            path.display()
+        )));
+    }
     let mut sink: Option<Sink> = None;
     let mut buf: Option<SampleBuffer<f32>> = None;
     let mut damaged = 0usize;
@@ -352,7 +375,7 @@ fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
     ) else {
         bail!("ffmpeg finds no audio stream in it");
     };
-    if fs == 0 || channels == 0 {
+    if fs == 0 || channels == 0 || channels > 64 {
         bail!("ffmpeg finds no audio stream in it");
     }
     let mut child = Command::new("ffmpeg")
@@ -372,6 +395,56 @@ fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
         .stderr(Stdio::piped())
         .spawn()
         .map_err(|e| anyhow!("ffmpeg: {e}"))?;
+    // ffmpeg's messages are read on a thread of their own as they come: a pipe holds 64 KiB,
+    // and ffmpeg blocked on a full stderr would never finish our stdout. The last lines are
+    // kept for the error.
+    let stderr = child.stderr.take().expect("piped");
+    let messages = std::thread::spawn(move || last_lines(stderr, 4096));
+    let result = decode_ffmpeg_output(&mut child, channels, fs, opts);
+    if result.is_err() {
+        let _ = child.kill();
+    }
+    let status = child.wait()?;
+    let err = messages.join().unwrap_or_default();
+    let sink = result?;
+    if !status.success() {
+        bail!(
+            "ffmpeg could not decode it: {}",
+            err.lines().last().unwrap_or("no message")
+        );
+    }
+    if let Some(last) = err.lines().last() {
+        eprintln!(
+            "warning: {}: ffmpeg met damage and skipped it ({last})",
+            path.display()
+        );
+    }
+    finish(Some(sink), fs as f64, path, "ffmpeg")
+}
+
+/// The last `keep` bytes (about) of what `r` gives, as text.
+fn last_lines(mut r: impl Read, keep: usize) -> String {
+    let mut tail: Vec<u8> = Vec::new();
+    let mut buf = [0u8; 8192];
+    while let Ok(n) = r.read(&mut buf) {
+        if n == 0 {
+            break;
+        }
+        tail.extend_from_slice(&buf[..n]);
+        if tail.len() > 2 * keep {
+            tail.drain(..tail.len() - keep);
+        }
+    }
+    String::from_utf8_lossy(&tail).trim().to_string()
+}
+
+/// ffmpeg's float frames from its stdout, mixed and decimated.
+fn decode_ffmpeg_output(
+    child: &mut std::process::Child,
+    channels: usize,
+    fs: u32,
+    opts: &AudioOptions,
+) -> Result<Sink> {
     let mut sink = Sink::new(opts.channel, channels, fs as f64, opts.top_hz)?;
     let mut stdout = child.stdout.take().expect("piped");
     let mut bytes = vec![0u8; 1 << 16];
@@ -395,16 +468,5 @@ fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
         bytes.copy_within(whole..have, 0);
         carry = have - whole;
     }
-    let mut err = String::new();
-    if let Some(mut e) = child.stderr.take() {
-        let _ = e.read_to_string(&mut err);
-    }
-    let status = child.wait()?;
-    if !status.success() {
-        bail!(
-            "ffmpeg could not decode it: {}",
-            err.lines().next().unwrap_or("no message")
-        );
-    }
-    finish(Some(sink), fs as f64, path, "ffmpeg")
+    Ok(sink)
 }

@@ -7,7 +7,7 @@
 /// The LZ4 frame magic number.
 const MAGIC: u32 = 0x184D_2204;
 /// Largest decompressed packet accepted.
-const MAX_OUTPUT: usize = 1 << 30;
+const MAX_OUTPUT: usize = super::MAX_PACKET as usize;
 /// Linked blocks may refer back this far.
 const WINDOW: usize = 64 * 1024;
 
@@ -67,10 +67,10 @@ pub(crate) fn decode_frames(input: &[u8], out: &mut Vec<u8>) -> Result<usize, St
                 .ok_or("LZ4 block runs past the packet")?;
             pos += len + if block_checksum { 4 } else { 0 };
             if n + max_block > MAX_OUTPUT {
-                return Err("LZ4 output exceeds 1 GiB".into());
+                return Err(super::over_limit((n + max_block) as u64));
             }
             if out.len() < n + max_block {
-                out.resize((n + max_block).max(out.len() * 2), 0);
+                out.resize((n + max_block).max(out.len() * 2).min(MAX_OUTPUT), 0);
             }
             if stored {
                 if len > max_block {
@@ -99,6 +99,43 @@ pub(crate) fn decode_frames(input: &[u8], out: &mut Vec<u8>) -> Result<usize, St
         }
     }
     Ok(n)
+}
+
+/// An upper bound of what the LZ4 frames in `input` decompress to (a block at most its
+/// frame's block size), read from the block headers alone; saturates on damage, which the
+/// decoder reports.
+pub(crate) fn decoded_bound(input: &[u8]) -> u64 {
+    let mut pos = 0usize;
+    let mut total = 0u64;
+    while pos < input.len() && total < MAX_OUTPUT as u64 {
+        let (Some(magic), Some(&flg), Some(&bd)) =
+            (u32_at(input, pos), input.get(pos + 4), input.get(pos + 5))
+        else {
+            return MAX_OUTPUT as u64;
+        };
+        if magic & 0xFFFF_FFF0 == 0x184D_2A50 {
+            let Some(len) = u32_at(input, pos + 4) else {
+                return MAX_OUTPUT as u64;
+            };
+            pos = pos.saturating_add(8).saturating_add(len as usize);
+            continue;
+        }
+        let max_block: u64 = 1 << (8 + 2 * ((bd >> 4) & 7) as u32).min(22);
+        pos += 6 + if flg & 0x08 != 0 { 8 } else { 0 } + if flg & 0x01 != 0 { 4 } else { 0 } + 1;
+        loop {
+            let Some(word) = u32_at(input, pos) else {
+                return MAX_OUTPUT as u64;
+            };
+            pos += 4;
+            if word == 0 {
+                break;
+            }
+            total += max_block;
+            pos = pos.saturating_add((word & 0x7FFF_FFFF) as usize + 4 * ((flg >> 4) & 1) as usize);
+        }
+        pos += 4 * ((flg >> 2) & 1) as usize;
+    }
+    total.min(MAX_OUTPUT as u64)
 }
 
 /// The one call into liblz4. Its `_safe` decoders are written to be safe on any input: they

@@ -23,13 +23,22 @@ pub use writer::Aedat4Writer;
 /// The 14-byte magic that starts every AEDAT 4.0 file.
 pub const MAGIC: &[u8; 14] = b"#!AER-DAT4.0\r\n";
 const FORMAT: &str = "AEDAT 4.0";
-/// Largest header or packet body accepted: far above what any writer produces, and a guard
-/// against allocating from a corrupt size field.
-const MAX_CHUNK: u64 = 1 << 30;
+/// Largest header, packet body or decompressed packet accepted (64 MiB: 4 M events in one
+/// packet). DV and dv-processing write a packet per camera read-out (a few to a few thousand
+/// events, at most tens of milliseconds); a packet past this is damage, so that a small file
+/// that expands hugely (a ZSTD frame of zeros, a frame header that lies) cannot exhaust memory.
+pub const MAX_PACKET: u64 = 64 << 20;
 /// Bytes of one event in an EventPacket.
 const EVENT_SIZE: usize = 16;
-/// Packets decompressed together in parallel.
+/// Packets decompressed together in parallel, at most.
 const PACKETS_PER_ROUND: usize = 16;
+/// A round holds packets until their decompressed sizes (as far as their headers bound them)
+/// reach this: with [`MAX_PACKET`] and [`BATCH_EVENTS`] it bounds what is in flight to a few
+/// hundred MiB whatever the file holds.
+const ROUND_BYTES: u64 = 32 << 20;
+/// Batches handed out hold at most this many events (a larger packet is split), so that the
+/// read-ahead queue's batches stay small.
+const BATCH_EVENTS: usize = 1 << 18;
 
 /// Packet compression of an AEDAT4 file (IOHeader field 0).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -178,8 +187,9 @@ thread_local! {
 const SCRATCH_KEPT: usize = 16 << 20;
 
 /// Decompresses one packet body into `scratch` (reused between packets, so it is zero-filled
-/// only when it grows) and returns the decompressed bytes. The output size is bounded so that a
-/// corrupt frame cannot make us allocate without limit.
+/// only when it grows) and returns the decompressed bytes. The output may not pass
+/// [`MAX_PACKET`]: a frame that claims or produces more is an error, found before allocating
+/// where the frame header says its size.
 fn decompress<'a>(
     codec: Compression,
     body: &'a [u8],
@@ -194,7 +204,8 @@ fn decompress<'a>(
         Compression::Zstd | Compression::ZstdHigh => {
             let fail = |e: &dyn std::fmt::Display| format!("ZSTD decompression failed: {e}");
             match zstd::zstd_safe::get_frame_content_size(body) {
-                Ok(Some(size)) if size <= MAX_CHUNK && body.len() >= 4 => {
+                Ok(Some(size)) if size > MAX_PACKET => Err(over_limit(size)),
+                Ok(Some(size)) if body.len() >= 4 => {
                     let size = size as usize;
                     if scratch.len() < size {
                         scratch.resize(size, 0);
@@ -207,13 +218,41 @@ fn decompress<'a>(
                     // no size in the frame header: stream it
                     scratch.clear();
                     zstd::stream::read::Decoder::new(body)
-                        .and_then(|d| d.take(MAX_CHUNK).read_to_end(scratch))
+                        .and_then(|d| d.take(MAX_PACKET + 1).read_to_end(scratch))
                         .map_err(|e| fail(&e))?;
+                    if scratch.len() as u64 > MAX_PACKET {
+                        return Err(over_limit(scratch.len() as u64));
+                    }
                     Ok(&scratch[..])
                 }
             }
         }
     }
+}
+
+/// The error for a packet that decompresses past [`MAX_PACKET`].
+fn over_limit(size: u64) -> String {
+    format!(
+        "a packet decompresses to {} bytes or more, over the {} MiB limit of a packet",
+        size,
+        MAX_PACKET >> 20
+    )
+}
+
+/// An upper bound of the size `body` decompresses to, read from its frame headers without
+/// decompressing (`MAX_PACKET` where they do not say: the decoder enforces it).
+fn decoded_bound(codec: Compression, body: &[u8]) -> u64 {
+    let bound = match codec {
+        Compression::None => body.len() as u64,
+        Compression::Lz4 | Compression::Lz4High => lz4::decoded_bound(body),
+        Compression::Zstd | Compression::ZstdHigh => {
+            match zstd::zstd_safe::get_frame_content_size(body) {
+                Ok(Some(size)) => size,
+                _ => MAX_PACKET,
+            }
+        }
+    };
+    bound.min(MAX_PACKET)
 }
 
 /// One 16-byte event record: two little-endian u64 loads instead of five field loads.
@@ -345,7 +384,7 @@ impl Aedat4Reader {
             return Err(corrupt(0, "missing #!AER-DAT4.0 magic".into()));
         }
         let hlen = u32::from_le_bytes(head[14..18].try_into().unwrap()) as u64;
-        if hlen > MAX_CHUNK || 18 + hlen > file_len {
+        if hlen > MAX_PACKET || 18 + hlen > file_len {
             return Err(trunc(18, &format!("IOHeader of {hlen} bytes")));
         }
         let mut header = vec![0u8; hlen as usize];
@@ -419,7 +458,8 @@ impl Aedat4Reader {
     /// error that stopped the reading, if any.
     fn read_round(&mut self, slots: &mut Vec<Slot>) -> (usize, Option<EventError>) {
         let mut count = 0;
-        while count < PACKETS_PER_ROUND && self.pos < self.end {
+        let mut bytes = 0;
+        while count < PACKETS_PER_ROUND && bytes < ROUND_BYTES && self.pos < self.end {
             let at = self.pos;
             if self.end - at < 8 {
                 return (count, Some(self.truncated(at, "packet header")));
@@ -430,8 +470,15 @@ impl Aedat4Reader {
             }
             let stream = i32::from_le_bytes(hdr[0..4].try_into().unwrap());
             let size = i32::from_le_bytes(hdr[4..8].try_into().unwrap());
-            if size < 0 || size as u64 > MAX_CHUNK {
+            if size < 0 {
                 return (count, Some(self.corrupt(at, format!("packet size {size}"))));
+            }
+            if size as u64 > MAX_PACKET {
+                let reason = format!(
+                    "a packet of {size} bytes, over the {} MiB limit of a packet",
+                    MAX_PACKET >> 20
+                );
+                return (count, Some(self.corrupt(at, reason)));
             }
             let size = size as u64;
             if size > self.end - at - 8 {
@@ -460,6 +507,7 @@ impl Aedat4Reader {
                 }
                 slot.at = at;
                 slot.size = size as usize;
+                bytes += decoded_bound(self.codec, &slot.body[..slot.size]);
                 count += 1;
             } else if let Err(e) = self.file.seek_relative(size as i64) {
                 return (count, Some(io_err(&self.path, e)));
@@ -488,8 +536,13 @@ impl Aedat4Reader {
                     .par_iter()
                     .map(|slot| {
                         let batch = SCRATCH.with_borrow_mut(|scratch| {
-                            let batch = decompress(codec, &slot.body[..slot.size], scratch)
-                                .and_then(decode_event_packet);
+                            // zstd's and liblz4's wrappers are not ours: a panic there
+                            // is this packet's damage
+                            let batch = crate::contain(|| {
+                                decompress(codec, &slot.body[..slot.size], scratch)
+                                    .and_then(decode_event_packet)
+                            })
+                            .and_then(|r| r);
                             if scratch.capacity() > SCRATCH_KEPT {
                                 *scratch = Vec::new();
                             }
@@ -514,7 +567,11 @@ impl Aedat4Reader {
         let read_error = std::mem::replace(&mut self.read_error, err_next);
         for (at, d) in decoded {
             match d {
-                Ok(Some(b)) if !b.is_empty() => self.pending.push_back((at, b)),
+                Ok(Some(b)) if !b.is_empty() => {
+                    for part in split(b, BATCH_EVENTS) {
+                        self.pending.push_back((at, part));
+                    }
+                }
                 Ok(_) => {}
                 Err(reason) => {
                     // deliver the events before the damage, then the error
@@ -555,6 +612,22 @@ impl Aedat4Reader {
     }
 }
 
+/// `b` in batches of at most `n` events, in order.
+fn split(mut b: EventBatch, n: usize) -> Vec<EventBatch> {
+    let mut parts = Vec::new();
+    while b.len() > n {
+        let tail = EventBatch {
+            t: b.t.split_off(n),
+            x: b.x.split_off(n),
+            y: b.y.split_off(n),
+            p: b.p.split_off(n),
+        };
+        parts.push(std::mem::replace(&mut b, tail));
+    }
+    parts.push(b);
+    parts
+}
+
 fn read_exact_or(
     file: &mut impl Read,
     buf: &mut [u8],
@@ -576,15 +649,16 @@ fn read_table(
     stream: i32,
 ) -> std::result::Result<TableSummary, String> {
     let len = file_len - pos;
-    if len > MAX_CHUNK {
+    if len > MAX_PACKET {
         return Err("FileDataTable too large".into());
     }
     file.seek(SeekFrom::Start(pos)).map_err(|e| e.to_string())?;
     let mut raw = vec![0u8; len as usize];
     file.read_exact(&mut raw).map_err(|e| e.to_string())?;
     let mut scratch = Vec::new();
-    let body = decompress(codec, &raw, &mut scratch)?;
-    let t = Table::size_prefixed_root(body, Some(b"FTAB")).map_err(|e| e.0)?;
+    let body = crate::contain(|| decompress(codec, &raw, &mut scratch).map(<[u8]>::to_vec))
+        .and_then(|r| r)?;
+    let t = Table::size_prefixed_root(&body, Some(b"FTAB")).map_err(|e| e.0)?;
     let mut s = TableSummary::default();
     for entry in t.table_vector(0).map_err(|e| e.0)? {
         let header = entry.struct_field(1, 8).map_err(|e| e.0)?;
