@@ -328,7 +328,10 @@ fn a_packet_that_expands_past_the_limit_is_damage_after_the_events_before_it() {
             all.extend_from(&b);
         }
         assert_eq!(all, events, "{name}: the events before the packet");
-        let err = r.damage().expect("the outsized packet is damage").to_string();
+        let err = r
+            .damage()
+            .expect("the outsized packet is damage")
+            .to_string();
         assert!(err.contains("64 MiB limit"), "{name}: {err}");
         assert!(err.contains(&path.display().to_string()), "{name}: {err}");
     }

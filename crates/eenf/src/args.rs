@@ -24,6 +24,40 @@ where
     PossibleValuesParser::new(names).try_map(|s| s.parse::<T>())
 }
 
+/// A number in `lo..=hi`, for flags read from the user: anything else (NaN, inf, out of range)
+/// is a one-line error naming the range, before any work or allocation is sized by it.
+pub fn number_in(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync {
+    move |s: &str| {
+        let v: f64 = s
+            .trim()
+            .parse()
+            .map_err(|_| format!("{s:?} is not a number"))?;
+        if v.is_finite() && (lo..=hi).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!("{s} is outside {lo}..={hi}"))
+        }
+    }
+}
+
+/// A whole number in `lo..=hi` (see [`number_in`]).
+pub fn count_in(
+    lo: usize,
+    hi: usize,
+) -> impl Fn(&str) -> Result<usize, String> + Clone + Send + Sync {
+    move |s: &str| {
+        let v: usize = s
+            .trim()
+            .parse()
+            .map_err(|_| format!("{s:?} is not a whole number in {lo}..={hi}"))?;
+        if (lo..=hi).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!("{s} is outside {lo}..={hi}"))
+        }
+    }
+}
+
 /// Tracker flags (shared by `extract`, `reference` and `bench`).
 #[derive(Debug, Clone, clap::Args)]
 pub struct TrackerArgs {
@@ -36,13 +70,13 @@ pub struct TrackerArgs {
     #[arg(long, default_value = "exact", value_parser = one_of::<PeakMethod>(&PeakMethod::NAMES))]
     pub peak: PeakMethod,
     /// STFT window length, s.
-    #[arg(long, default_value_t = 16.0)]
+    #[arg(long, default_value_t = 16.0, value_parser = number_in(0.05, 3600.0))]
     pub window: f64,
     /// STFT step, s (one estimate per step).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = number_in(0.001, 3600.0))]
     pub step: f64,
     /// Half width of the search band (and band-pass) around each line, Hz.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 2.0, value_parser = number_in(0.01, 20.0))]
     pub half_band: f64,
 }
 
@@ -72,13 +106,13 @@ pub struct MethodArgs {
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub filter_order: u32,
     /// Running-median length of the outlier correction (0 or 1 disables it).
-    #[arg(long, default_value_t = 21)]
+    #[arg(long, default_value_t = 21, value_parser = count_in(0, 10_001))]
     pub median_len: usize,
     /// Outlier threshold on the 2f0 scale, Hz.
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, default_value_t = 0.02, value_parser = number_in(0.0, 10.0))]
     pub median_threshold: f64,
     /// Harmonic-selection segment length, in estimates.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = count_in(1, 100_000))]
     pub segment: usize,
     /// Harmonic-selection rule: consensus (the smoothest among harmonics that agree with
     /// another one, within --agree-hz), smoothest (the paper: the smoothest harmonic trace per
@@ -88,10 +122,10 @@ pub struct MethodArgs {
     #[arg(long, default_value = "consensus", value_parser = one_of::<HarmonicSelection>(&HarmonicSelection::NAMES))]
     pub selection: HarmonicSelection,
     /// Largest step of the journal rule's 2f0 trace between estimates, Hz (on the ENF scale).
-    #[arg(long, default_value_t = HarmonicSelection::DEFAULT_JUMP_HZ)]
+    #[arg(long, default_value_t = HarmonicSelection::DEFAULT_JUMP_HZ, value_parser = number_in(0.0, 10.0))]
     pub jump_hz: f64,
     /// Agreement tolerance of the consensus rule, Hz (on the ENF scale).
-    #[arg(long, default_value_t = HarmonicSelection::DEFAULT_AGREE_HZ)]
+    #[arg(long, default_value_t = HarmonicSelection::DEFAULT_AGREE_HZ, value_parser = number_in(0.0, 10.0))]
     pub agree_hz: f64,
     /// Trace every pixel. By default, when events are stamped one by one (DVS128, DAVIS,
     /// Prophesee), only the tiles of pixels whose flicker stands out are traced (the
@@ -223,7 +257,7 @@ pub struct VideoArgs {
     #[arg(long)]
     pub video: Option<String>,
     /// Scale the videos' frames by this factor (0..1], for speed.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = number_in(0.001, 1.0))]
     pub video_scale: f64,
     /// Also encode each video as MP4 (H.264 at the camera's CRF: 28 webcam, 20 phone) with
     /// ffmpeg, as the cameras' own pipelines do.
@@ -369,16 +403,16 @@ impl AudioArgs {
 #[derive(Debug, Clone, clap::Args)]
 pub struct VideoMethodArgs {
     /// Grid frequency, 50 or 60 (default: detected from the flicker).
-    #[arg(long)]
+    #[arg(long, value_parser = number_in(1.0, 1000.0))]
     pub nominal: Option<f64>,
     /// The sensor's readout time (first row to last row), ms: sets the idle rows.
-    #[arg(long, conflicts_with_all = ["idle", "virtual_rows"])]
+    #[arg(long, conflicts_with_all = ["idle", "virtual_rows"], value_parser = number_in(0.0, 1000.0))]
     pub readout_ms: Option<f64>,
     /// Idle rows: `auto` estimates them from the flicker's ripple within frames.
     #[arg(long, value_parser = ["auto"])]
     pub idle: Option<String>,
     /// Virtual rows per frame period (real plus idle), if known.
-    #[arg(long, conflicts_with = "idle")]
+    #[arg(long, conflicts_with = "idle", value_parser = number_in(0.0, 100_000.0))]
     pub virtual_rows: Option<f64>,
     /// Row sampling: zero-pad (idle rows as zeros), naive (rows concatenated), global (one
     /// sample per frame, tracked at the alias of the flicker).
@@ -443,7 +477,7 @@ pub struct SimulateArgs {
     #[arg(long, default_value = "led")]
     pub lamp: String,
     /// Length of the recording, s.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, value_parser = number_in(0.01, 86_400.0))]
     pub duration: f64,
     /// Where the ENF comes from: `synthetic` (a grid-like random process), a mains WAV or a
     /// trace CSV (`time_s,enf_hz`, or `index,value` at --enf-step), optionally with a start
@@ -451,7 +485,7 @@ pub struct SimulateArgs {
     #[arg(long, default_value = "synthetic")]
     pub enf: String,
     /// Seconds between the values of an `index,value` trace CSV.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 2.0, value_parser = number_in(0.001, 3600.0))]
     pub enf_step: f64,
     /// Grid frequency of a synthetic ENF: 50 or 60 (a WAV's or trace's own is detected).
     #[arg(long, default_value_t = 50)]
@@ -472,18 +506,18 @@ pub struct SimulateArgs {
     #[arg(long, default_value = "dvxplorer")]
     pub readout: String,
     /// Overall light level (1 = indoor room); the scene classes set their own.
-    #[arg(long)]
+    #[arg(long, value_parser = number_in(0.0, 1e6))]
     pub illumination: Option<f64>,
     /// Share of non-flickering light (daylight), 0..1.
-    #[arg(long)]
+    #[arg(long, value_parser = number_in(0.0, 1.0))]
     pub ambient: Option<f64>,
     /// How much brighter the first lamp is inside its pool (`lamp-spot`) or bulb
     /// (`extreme-bright`) than elsewhere: sets how strongly those pixels flicker.
-    #[arg(long)]
+    #[arg(long, value_parser = number_in(0.0, 1e6))]
     pub spot_gain: Option<f64>,
     /// Background activity: each pixel's noise events per second under an indoor room's
     /// light (more in the dark), e.g. 0.5 for an old DVS128. Default: the simulator's 0.02.
-    #[arg(long)]
+    #[arg(long, value_parser = number_in(0.0, 10_000.0))]
     pub noise_hz: Option<f64>,
     /// Local start time of the recording (names, timestamps; a WAV or CSV source named with
     /// its time sets it).
@@ -591,7 +625,7 @@ impl SimulateArgs {
 #[derive(Debug, Clone, clap::Args)]
 pub struct MatchArgs {
     /// Candidates to list.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = count_in(1, 10_000))]
     pub top: usize,
     /// Check a claimed start time (e.g. 2022-08-17T16:10:00+08:00): its score, rank and
     /// significance.
@@ -601,7 +635,7 @@ pub struct MatchArgs {
     #[arg(long, default_value = "combined", value_parser = one_of::<eenf_dsp::matching::Score>(&eenf_dsp::matching::Score::NAMES))]
     pub score: eenf_dsp::matching::Score,
     /// A candidate is a match when its p-value is below this.
-    #[arg(long, default_value_t = eenf_dsp::matching::DEFAULT_ALPHA)]
+    #[arg(long, default_value_t = eenf_dsp::matching::DEFAULT_ALPHA, value_parser = number_in(1e-300, 1.0))]
     pub alpha: f64,
     /// UTC offset of local times in WAV names.
     #[arg(long, default_value = "+00:00", allow_hyphen_values = true)]

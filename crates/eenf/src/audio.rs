@@ -196,6 +196,10 @@ impl Sound<'_> {
     }
 }
 
+/// The highest sample rate accepted for sound in memory (10 MHz: far above any recorder's,
+/// and a bound on the decimator's work per sample).
+pub const MAX_RATE_HZ: f64 = 10e6;
+
 /// Sound in memory (`interleaved` frames of `channels` channels at `fs` Hz) read as `opts`
 /// says, with the mix and the streaming decimation a file's sound goes through. NaN or
 /// infinite samples are an error (they would spread through every filter).
@@ -206,9 +210,9 @@ pub fn audio_from_samples(
     name: &Path,
     opts: &AudioOptions,
 ) -> Result<Audio> {
-    if !(fs.is_finite() && fs > 0.0) {
+    if !(fs.is_finite() && fs > 0.0 && fs <= MAX_RATE_HZ) {
         bail!(
-            "{}: the sample rate must be positive, not {fs}",
+            "{}: the sample rate must be above 0 and at most {MAX_RATE_HZ} Hz, not {fs}",
             name.display()
         );
     }

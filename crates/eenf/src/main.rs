@@ -59,7 +59,17 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => e.exit(), // --help, --version
+        Err(e) => {
+            // one line, as every other error: clap's first line says what is wrong
+            let text = e.render().to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments");
+            eprintln!("eenf: {}", first.trim_end());
+            return ExitCode::from(2);
+        }
+    };
     if let Err(e) = eenf::output::clean_up_on_signals() {
         eprintln!("eenf: warning: {e:#}");
     }
@@ -90,7 +100,10 @@ fn main() -> ExitCode {
                         _ => None,
                     }
                 });
-                io.is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+                let json = c
+                    .downcast_ref::<serde_json::Error>()
+                    .and_then(serde_json::Error::io_error_kind);
+                io.map(std::io::Error::kind).or(json) == Some(std::io::ErrorKind::BrokenPipe)
             });
             if closed {
                 return ExitCode::SUCCESS;

@@ -436,15 +436,51 @@ impl Trace {
     /// Reads a trace file: eenf JSON, a `time_s,enf_hz` CSV, or (with `index_step_s`) an
     /// `index,value` CSV whose values are `index_step_s` apart.
     pub fn read(path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
-        let mut text = String::new();
-        std::fs::File::open(path)
-            .and_then(|mut f| f.read_to_string(&mut text))
-            .with_context(|| format!("{}", path.display()))?;
+        let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
+        let text = read_text_lines(file, path)?;
         Self::parse(&text, path, index_step_s)
     }
 
     /// Parses the text of a trace file named `path` (see [`Trace::read`]).
     pub fn parse(text: &str, path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
+        let trace = Self::parse_any(text, path, index_step_s)?;
+        trace.check(path)?;
+        Ok(trace)
+    }
+
+    /// Refuses what no ENF trace holds and what would size work by an absurd number: a step
+    /// outside 1 ms .. 1 day, times that do not rise, values beyond ±1e6 (Hz or mHz).
+    fn check(&self, path: &Path) -> Result<()> {
+        let name = path.display();
+        if !(self.step_s.is_finite() && (MIN_STEP_S..=MAX_STEP_S).contains(&self.step_s)) {
+            bail!(
+                "{name}: its estimates are {} s apart; an ENF trace steps by {MIN_STEP_S} s to {MAX_STEP_S} s",
+                self.step_s
+            );
+        }
+        if let Some(i) = self
+            .time_s
+            .windows(2)
+            .position(|w| !(w[1] - w[0] >= MIN_STEP_S && w[1].is_finite()))
+        {
+            bail!(
+                "{name}: time_s goes from {} to {} at estimate {}: times must rise by {MIN_STEP_S} s or more",
+                self.time_s[i],
+                self.time_s[i + 1],
+                i + 1
+            );
+        }
+        if let Some(i) = self.enf_hz.iter().position(|v| v.abs() > MAX_VALUE) {
+            bail!(
+                "{name}: estimate {} is {:e}, beyond any frequency (or deviation) of a grid",
+                i,
+                self.enf_hz[i]
+            );
+        }
+        Ok(())
+    }
+
+    fn parse_any(text: &str, path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
         let trimmed = text.trim_start();
         if trimmed.starts_with('{') {
             return Self::parse_json(trimmed, path);
@@ -564,6 +600,56 @@ impl Trace {
             ..Trace::new(step, values)
         })
     }
+}
+
+/// The finest step of a trace accepted (operators publish 0.1 s at the finest).
+const MIN_STEP_S: f64 = 1e-3;
+/// The coarsest step of a trace accepted.
+const MAX_STEP_S: f64 = 86_400.0;
+/// The largest magnitude of a trace value accepted.
+const MAX_VALUE: f64 = 1e6;
+/// The longest line of a trace file (a trace's lines are a few dozen bytes; JSON is written
+/// one value a line).
+const MAX_LINE: u64 = 1 << 20;
+
+/// The text of a trace file, read line by line: a line longer than [`MAX_LINE`] (a binary
+/// file, a sparse file of zeros) is an error before it is held in memory.
+fn read_text_lines(file: std::fs::File, path: &Path) -> Result<String> {
+    use std::io::BufRead;
+    let mut r = std::io::BufReader::new(file);
+    let mut text = Vec::new();
+    let mut line_no = 0usize;
+    loop {
+        line_no += 1;
+        let start = text.len();
+        let n = (&mut r)
+            .take(MAX_LINE + 1)
+            .read_until(b'\n', &mut text)
+            .with_context(|| format!("{}", path.display()))?;
+        if n == 0 {
+            break;
+        }
+        if n as u64 > MAX_LINE && text.last() != Some(&b'\n') {
+            bail!(
+                "{}: line {line_no} is longer than {} KiB: not a trace file",
+                path.display(),
+                MAX_LINE >> 10
+            );
+        }
+        if text[start..].contains(&0) {
+            bail!(
+                "{}: line {line_no} holds binary data: not a trace file",
+                path.display()
+            );
+        }
+    }
+    String::from_utf8(text).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: not text (invalid UTF-8 at byte {}): not a trace file",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        )
+    })
 }
 
 /// The step of a trace's times (1 s for a single value).

@@ -335,6 +335,7 @@ fn a_closed_pipe_is_quiet_and_a_full_stdout_one_line() {
     for args in [
         vec!["-q", "reference", hour.to_str().unwrap()],
         vec!["-q", "extract", rec.to_str().unwrap()],
+        vec!["-q", "extract", rec.to_str().unwrap(), "--json"],
     ] {
         let mut child = Command::new(env!("CARGO_BIN_EXE_eenf"))
             .args(&args)
@@ -369,4 +370,120 @@ fn a_closed_pipe_is_quiet_and_a_full_stdout_one_line() {
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(err.contains("No space left"), "{err}");
     }
+}
+
+/// Absurd numbers on the command line are one-line errors naming the flag and its range,
+/// before anything is sized by them.
+#[test]
+fn absurd_flags_are_one_line_errors_with_the_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("t.csv"), "time_s,enf_hz\n0,50\n1,50.01\n").unwrap();
+    for (args, flag) in [
+        (
+            vec!["match", "t.csv", "t.csv", "--top", "18446744073709551615"],
+            "--top",
+        ),
+        (
+            vec!["match", "t.csv", "t.csv", "--top", "1000000000"],
+            "--top",
+        ),
+        (
+            vec!["extract", "x.aedat4", "--median-len", "1000000000"],
+            "--median-len",
+        ),
+        (vec!["extract", "x.aedat4", "--window", "nan"], "--window"),
+        (vec!["reference", "x.wav", "--step", "1e-300"], "--step"),
+        (vec!["simulate", "--duration", "1e12"], "--duration"),
+        (vec!["match", "t.csv", "t.csv", "--alpha", "7"], "--alpha"),
+    ] {
+        let (ok, _, err) = eenf(&args, d);
+        assert!(!ok, "{args:?} succeeded");
+        let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+        assert_eq!(lines.len(), 1, "{args:?}: {err}");
+        assert!(
+            lines[0].contains(flag) && lines[0].contains("outside"),
+            "{err}"
+        );
+    }
+}
+
+/// Trace files that no ENF trace can be: steps of a nanosecond, values of 1e308, a binary
+/// file, one endless line.
+#[test]
+fn impossible_traces_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let rows = |f: &dyn Fn(usize) -> String| -> String {
+        let mut s = String::from("time_s,enf_hz\n");
+        for i in 0..200 {
+            s += &f(i);
+        }
+        s
+    };
+    let clip = rows(&|i| format!("{i},{}\n", 50.0 + 0.01 * ((i as f64) * 0.1).sin()));
+    std::fs::write(d.join("clip.csv"), &clip).unwrap();
+    std::fs::write(d.join("ns.csv"), rows(&|i| format!("{}e-9,50.0\n", i))).unwrap();
+    std::fs::write(
+        d.join("huge.csv"),
+        rows(&|i| format!("{i},{}1e308\n", if i % 2 == 0 { "-" } else { "" })),
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("back.csv"),
+        rows(&|i| format!("{},50.0\n", (i % 7) as f64)),
+    )
+    .unwrap();
+    std::fs::write(d.join("bin.csv"), [0u8, 159, 146, 150, 0, 1, 2]).unwrap();
+    std::fs::write(d.join("long.csv"), vec![b'7'; 3 << 20]).unwrap();
+    fails(&["match", "clip.csv", "ns.csv"], d, "ns.csv", "s apart");
+    fails(
+        &["match", "clip.csv", "huge.csv"],
+        d,
+        "huge.csv",
+        "beyond any frequency",
+    );
+    fails(
+        &["match", "clip.csv", "back.csv"],
+        d,
+        "back.csv",
+        "times must rise",
+    );
+    fails(
+        &["match", "clip.csv", "bin.csv"],
+        d,
+        "bin.csv",
+        "not a trace file",
+    );
+    fails(
+        &["match", "clip.csv", "long.csv"],
+        d,
+        "long.csv",
+        "longer than",
+    );
+    fails(&["compare", "ns.csv", "clip.csv"], d, "ns.csv", "s apart");
+}
+
+/// A WAV whose header says 0 Hz (Symphonia panicked on it) is a one-line error.
+#[test]
+fn a_wav_at_zero_hertz_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let data = vec![0u8; 2000];
+    let mut wav = Vec::new();
+    wav.extend_from_slice(b"RIFF");
+    wav.extend_from_slice(&(36 + data.len() as u32).to_le_bytes());
+    wav.extend_from_slice(b"WAVEfmt ");
+    wav.extend_from_slice(&16u32.to_le_bytes());
+    wav.extend_from_slice(&1u16.to_le_bytes()); // PCM
+    wav.extend_from_slice(&1u16.to_le_bytes()); // mono
+    wav.extend_from_slice(&0u32.to_le_bytes()); // 0 Hz
+    wav.extend_from_slice(&0u32.to_le_bytes());
+    wav.extend_from_slice(&2u16.to_le_bytes());
+    wav.extend_from_slice(&16u16.to_le_bytes());
+    wav.extend_from_slice(b"data");
+    wav.extend_from_slice(&(data.len() as u32).to_le_bytes());
+    wav.extend_from_slice(&data);
+    std::fs::write(d.join("zero.wav"), &wav).unwrap();
+    fails(&["-q", "audio", "zero.wav"], d, "zero.wav", "0");
 }

@@ -26,10 +26,10 @@ pub struct Args {
     #[arg(long, default_value = "e-enf,v-enf-lr,v-enf-hr")]
     pub methods: String,
     /// Recordings processed at once (default: one per core, fewer if the memory budget says so).
-    #[arg(long)]
+    #[arg(long, value_parser = eenf::args::count_in(1, 256))]
     pub jobs: Option<usize>,
     /// Memory budget, MiB: bounds the recordings processed at once.
-    #[arg(long, default_value_t = 4096)]
+    #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u64).range(64..=1 << 30))]
     pub memory_mb: u64,
     /// Write the Markdown report here.
     #[arg(long)]

@@ -45,7 +45,7 @@ pub struct BuildArgs {
     #[arg(long)]
     pub start: Option<String>,
     /// Seconds between values of `index` CSVs.
-    #[arg(long)]
+    #[arg(long, value_parser = eenf::args::number_in(0.001, 3600.0))]
     pub step: Option<f64>,
 }
 

@@ -46,7 +46,7 @@ pub struct Args {
     #[arg(long)]
     pub resolution: Option<String>,
     /// Length of every recording, s (default: the preset's).
-    #[arg(long)]
+    #[arg(long, value_parser = eenf::args::number_in(0.01, 86_400.0))]
     pub duration: Option<f64>,
     /// Readout: dvxplorer, prophesee or dvs128 (the `lamp-spot` preset sets its own).
     #[arg(long, default_value = "dvxplorer")]
