@@ -195,8 +195,11 @@ pub fn enf_from_lines(
     let audible = audibility(&harmonics, p.segment_len);
     let (enf_hz, chosen) = select_audible_harmonics(&traces, &audible, p.segment_len, p.selection);
     if enf_hz.iter().all(|v| !v.is_finite()) {
-        return Err(DspError::NoTone("the bands hold no signal".into()));
+        return Err(DspError::NoTone(
+            "no line inside the bands (each window's peak sat at a band's edge, or they hold no signal)".into(),
+        ));
     }
+    check_near_nominal(&enf_hz, p.nominal_hz)?;
     // the journal rule chooses per estimate
     let seg = match p.selection {
         HarmonicSelection::Journal(_) => 1,
@@ -285,7 +288,39 @@ pub fn reference_enf(x: &[f64], fs: f64, p: &EnfParams) -> Result<Vec<f64>, DspE
         });
     }
     let band = (p.nominal_hz - p.half_band_hz, p.nominal_hz + p.half_band_hz);
-    Ok(p.tracker(fs).track(x, band))
+    let enf = p.tracker(fs).track(x, band);
+    if enf.iter().all(|v| !v.is_finite()) {
+        return Err(DspError::NoTone(format!(
+            "no line inside {:.2}-{:.2} Hz (each window's peak sat at the band's edge)",
+            band.0, band.1
+        )));
+    }
+    check_near_nominal(&enf, p.nominal_hz)?;
+    Ok(enf)
+}
+
+/// How far from its nominal a grid's frequency may stay for the length of a recording: grids
+/// are held within ±0.2 Hz outside emergencies (ENTSO-E's alert level is ±200 mHz; North
+/// America's deviations are a few tens of mHz). A steady tone beyond it is not the mains.
+pub const MAX_NOMINAL_OFFSET_HZ: f64 = 0.2;
+
+/// Refuses a trace whose median lies more than [`MAX_NOMINAL_OFFSET_HZ`] from `nominal_hz`.
+pub fn check_near_nominal(enf_hz: &[f64], nominal_hz: f64) -> Result<(), DspError> {
+    let mut finite: Vec<f64> = enf_hz.iter().copied().filter(|v| v.is_finite()).collect();
+    if finite.is_empty() {
+        return Ok(());
+    }
+    let m = finite.len() / 2;
+    let median = *finite.select_nth_unstable_by(m, f64::total_cmp).1;
+    if (median - nominal_hz).abs() > MAX_NOMINAL_OFFSET_HZ {
+        return Err(DspError::NoTone(format!(
+            "the line sits at {median:.3} Hz, {:.0} mHz from {nominal_hz} Hz: no grid stays \
+             that far off (at most {:.0} mHz); it is not the mains",
+            1e3 * (median - nominal_hz).abs(),
+            1e3 * MAX_NOMINAL_OFFSET_HZ
+        )));
+    }
+    Ok(())
 }
 
 /// How far a spectral line at `target` Hz stands above the spectrum around it (ratio of the

@@ -181,6 +181,11 @@ impl StftTracker {
                             (f, snr(power.max(mag)))
                         }
                     };
+                    // a maximum on the band's first or last bin is the slope of something
+                    // outside the band (or noise), not a line within it: no estimate
+                    if k == k_lo || k == k_hi || !(band.0..=band.1).contains(&f) {
+                        return (f64::NAN, snr_db);
+                    }
                     (f, snr_db)
                 },
             )
