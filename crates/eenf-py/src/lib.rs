@@ -570,7 +570,7 @@ fn match_trace(
     let t = trace.0.clone();
     py.detach(|| {
         let nominal = eenf::reference::match_grid(&t, &name)?;
-        let tz = eenf::time::tz_offset(&m.tz)?;
+        let tz = m.tz.as_deref().map(eenf::time::tz_offset).transpose()?;
         let refs =
             eenf::reference::ReferenceSeries::load(&reference, nominal, tz, &Progress::hidden())?;
         let query = m.query();

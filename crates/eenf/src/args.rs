@@ -637,9 +637,10 @@ pub struct MatchArgs {
     /// A candidate is a match when its p-value is below this.
     #[arg(long, default_value_t = eenf_dsp::matching::DEFAULT_ALPHA, value_parser = number_in(1e-300, 1.0))]
     pub alpha: f64,
-    /// UTC offset of local times in WAV names.
-    #[arg(long, default_value = "+00:00", allow_hyphen_values = true)]
-    pub tz: String,
+    /// Zone of the local times in hourly WAV names, as a UTC offset (+08:00, Z); also the zone
+    /// results are shown in beside UTC. Names in local time need it: none is assumed.
+    #[arg(long, allow_hyphen_values = true)]
+    pub tz: Option<String>,
 }
 
 impl MatchArgs {

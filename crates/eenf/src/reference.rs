@@ -259,13 +259,26 @@ pub fn reference_for_recording(
 }
 
 /// Unix time of an hourly reference's name read as local time at `tz_s` seconds east of UTC.
-pub fn wav_start(path: &Path, tz_s: f64) -> Result<f64> {
+/// The names carry no zone, so none is assumed: without `tz_s` it is an error that says how to
+/// give it.
+pub fn wav_start(path: &Path, tz_s: Option<f64>) -> Result<f64> {
     let t = crate::dataset::reference_hour(path).with_context(|| {
         format!(
             "{}: the name gives no start time (expected 2022_08_17_Wed_16_00_00.wav)",
             path.display()
         )
     })?;
+    let Some(tz_s) = tz_s else {
+        bail!(
+            "{}: its name gives a local time ({}-{:02}-{:02} {:02}:00) but not its zone: give the \
+             zone with --tz (e.g. --tz +08:00 where it was recorded in China, --tz Z for UTC)",
+            path.display(),
+            t.year(),
+            t.month(),
+            t.day(),
+            t.hour()
+        );
+    };
     Ok(t.unix_seconds(tz_s))
 }
 
@@ -278,6 +291,8 @@ pub struct ReferenceSeries {
     pub start: f64,
     /// Whether `start` is an absolute time.
     pub absolute: bool,
+    /// The zone (seconds east of UTC) its times are also shown in, when one was given.
+    pub zone_s: Option<f64>,
     /// Seconds between values.
     pub step: f64,
     /// The values.
@@ -345,7 +360,12 @@ impl ReferenceSeries {
     pub fn time_label(&self, offset: f64) -> String {
         let t = self.start + offset * self.step;
         if self.absolute {
-            crate::time::utc(t)
+            match self.zone_s {
+                Some(z) if z != 0.0 => {
+                    format!("{} ({})", crate::time::utc(t), crate::time::local(t, z))
+                }
+                _ => crate::time::utc(t),
+            }
         } else {
             format!("{t:.1} s")
         }
@@ -353,7 +373,12 @@ impl ReferenceSeries {
 
     /// The `nominal` Hz series at `path`: a store (its grids of that frequency), a folder of
     /// hourly WAVs (traced, local names at `tz_s`), a WAV, or a trace file.
-    pub fn load(path: &Path, nominal: f64, tz_s: f64, progress: &Progress) -> Result<Vec<Self>> {
+    pub fn load(
+        path: &Path,
+        nominal: f64,
+        tz_s: Option<f64>,
+        progress: &Progress,
+    ) -> Result<Vec<Self>> {
         if path.is_dir() {
             let grids = RefSeries::grids(path)?;
             if !grids.is_empty() {
@@ -368,6 +393,7 @@ impl ReferenceSeries {
                         name: g,
                         start: meta.start_unix_s,
                         absolute: true,
+                        zone_s: tz_s,
                         step: meta.step_s,
                         values: SeriesValues::Stored {
                             values: s.values,
@@ -399,15 +425,17 @@ impl ReferenceSeries {
                 name: path.display().to_string(),
                 start: series.meta.start_unix_s,
                 absolute: true,
+                zone_s: tz_s,
                 step: 1.0,
                 values: SeriesValues::Hz(series.hz()),
             }]);
         }
         let (start, absolute, step, hz) = if crate::wav::is_wav(path) {
             let trace = reference_file(path, Nominal::Hz(nominal), &EnfParams::default())?;
-            match wav_start(path, tz_s) {
-                Ok(s) => (s, true, 1.0, trace.enf_hz),
-                Err(_) => (0.0, false, 1.0, trace.enf_hz),
+            if crate::dataset::reference_hour(path).is_some() {
+                (wav_start(path, tz_s)?, true, 1.0, trace.enf_hz)
+            } else {
+                (0.0, false, 1.0, trace.enf_hz)
             }
         } else {
             let t = Trace::read(path, None)?;
@@ -422,6 +450,7 @@ impl ReferenceSeries {
             name: path.display().to_string(),
             start,
             absolute,
+            zone_s: tz_s,
             step,
             values: SeriesValues::Hz(hz),
         }])

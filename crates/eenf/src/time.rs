@@ -99,8 +99,9 @@ impl LocalTime {
     }
 }
 
-/// Parses a time: Unix seconds (`1660723800`), or ISO 8601 / RFC 3339 with an optional UTC
-/// offset (`2022-08-17T16:10:00+08:00`, `2022-08-17T08:10:00Z`; none means UTC). Unix seconds.
+/// Parses a time: Unix seconds (`1660723800`), or ISO 8601 / RFC 3339 with its UTC offset
+/// (`2022-08-17T16:10:00+08:00`, `2022-08-17T08:10:00Z`). A time without a zone is refused,
+/// never taken as UTC. Unix seconds.
 pub fn parse_time(s: &str) -> Result<f64> {
     if let Ok(v) = s.parse::<f64>() {
         return Ok(v);
@@ -114,8 +115,10 @@ pub fn parse_time(s: &str) -> Result<f64> {
     let ts = match s.parse::<Timestamp>() {
         Ok(ts) => ts,
         Err(_) => {
-            let dt: DateTime = s.parse().map_err(|_| bad())?;
-            Offset::UTC.to_timestamp(dt).map_err(|_| bad())?
+            if s.parse::<DateTime>().is_ok() {
+                bail!("{s:?} names no time zone: add Z for UTC or the offset, e.g. {s}+08:00");
+            }
+            return Err(bad());
         }
     };
     Ok(ts.as_second() as f64 + ts.subsec_nanosecond() as f64 * 1e-9)
@@ -153,6 +156,20 @@ pub fn offset_of(s: &str) -> Result<f64> {
         .map(|i| &s[i..])
         .unwrap_or("Z");
     tz_offset(tail).context("the time's UTC offset")
+}
+
+/// Unix seconds as the wall-clock time at `tz_s` seconds east of UTC, with its offset:
+/// `2022-08-17 16:10:00 +08:00`.
+pub fn local(unix_s: f64, tz_s: f64) -> String {
+    let shifted = utc(unix_s + tz_s);
+    let minutes = (tz_s / 60.0).round() as i64;
+    let sign = if minutes < 0 { '-' } else { '+' };
+    format!(
+        "{} {sign}{:02}:{:02}",
+        shifted.trim_end_matches('Z').replace('T', " "),
+        minutes.abs() / 60,
+        minutes.abs() % 60
+    )
 }
 
 /// A µs Unix timestamp as ISO 8601 UTC with microseconds, e.g. `2022-08-17T08:10:00.000000Z`.

@@ -164,3 +164,51 @@ fn an_eenf_trace_from_a_simulated_recording_is_placed_at_its_time() {
     assert!((top.offset - 4800.0).abs() <= 1.0, "{top:?}");
     assert!(top.p_value < DEFAULT_ALPHA, "{top:?}");
 }
+
+/// The hourly WAVs are named in local time: without `--tz`, `match` refuses to guess the zone
+/// (it once reported the right moment eight hours off, labelled UTC); with it, the moment is
+/// given in UTC and in that zone; a claimed time without a zone is refused.
+#[test]
+#[ignore = "needs ../shared"]
+fn local_file_names_need_their_zone() {
+    let refs = common::shared("enf-reference").join("enf-reference");
+    let hour = refs.join("2022_08_17_Wed_17_00_00.wav");
+    let trace = reference_file(&hour, Nominal::Hz(50.0), &EnfParams::default()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let clip = dir.path().join("clip.csv");
+    let mut text = String::from("time_s,enf_hz\n");
+    for (i, v) in trace.enf_hz[600..900].iter().enumerate() {
+        text += &format!("{i},{v}\n");
+    }
+    std::fs::write(&clip, text).unwrap();
+    let run = |extra: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_eenf"))
+            .args(["-q", "match"])
+            .arg(&clip)
+            .arg(&refs)
+            .args(["--top", "1"])
+            .args(extra)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).to_string()
+            + &String::from_utf8_lossy(&out.stderr);
+        (out.status.success(), text)
+    };
+    let (ok, text) = run(&[]);
+    assert!(
+        !ok && text.contains("--tz") && !text.contains("T09:"),
+        "{text}"
+    );
+    let (ok, text) = run(&["--tz", "+08:00"]);
+    assert!(ok, "{text}");
+    // the clip starts at 17:10:00 local (09:10:00 UTC), to within the sub-second fit
+    let (utc, local) = if text.contains("T09:09:59") {
+        ("T09:09:59", "(2022-08-17 17:09:59")
+    } else {
+        ("T09:10:00", "(2022-08-17 17:10:00")
+    };
+    assert!(text.contains(utc) && text.contains(local), "{text}");
+    assert!(text.contains(" +08:00)"), "{text}");
+    let (ok, text) = run(&["--tz", "+08:00", "--verify", "2022-08-17T17:10:00"]);
+    assert!(!ok && text.contains("no time zone"), "{text}");
+}

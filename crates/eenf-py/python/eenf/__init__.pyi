@@ -175,7 +175,7 @@ def match(
     verify: Optional[str] = None,
     score: Literal["combined", "cc"] = "combined",
     alpha: float = 0.001,
-    tz: str = "+00:00",
+    tz: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def simulate(
     output: Optional[PathLike] = None,

@@ -33,7 +33,7 @@ pub struct Args {
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let trace = Trace::read(&a.trace, None)?;
     let nominal = match_grid(&trace, &a.trace)?;
-    let tz = tz_offset(&a.search.tz)?;
+    let tz = a.search.tz.as_deref().map(tz_offset).transpose()?;
     let refs = ReferenceSeries::load(&a.reference, nominal, tz, &progress)?;
     let query = a.search.query();
     let report = match_trace_in(&trace, &a.trace, &refs, &query)?;

@@ -38,9 +38,10 @@ pub struct BuildArgs {
     /// Grid name (default: `grid50` or `grid60` from the data).
     #[arg(long)]
     pub grid: Option<String>,
-    /// UTC offset of the local times in WAV names, e.g. +08:00.
-    #[arg(long, default_value = "+00:00", allow_hyphen_values = true)]
-    pub tz: String,
+    /// Zone of the local times in WAV names, as a UTC offset (+08:00, Z). Names in local time
+    /// need it: none is assumed.
+    #[arg(long, allow_hyphen_values = true)]
+    pub tz: Option<String>,
     /// Start time of the first trace CSV (UTC, or with an offset).
     #[arg(long)]
     pub start: Option<String>,
@@ -50,7 +51,7 @@ pub struct BuildArgs {
 }
 
 fn build(a: BuildArgs, progress: Progress) -> Result<()> {
-    let tz = tz_offset(&a.tz)?;
+    let tz = a.tz.as_deref().map(tz_offset).transpose()?;
     let bar = progress.steps(a.inputs.len() as u64, "adding references");
     let mut series: Vec<RefSeries> = Vec::new();
     let mut next_start = a.start.as_deref().map(parse_time).transpose()?;
