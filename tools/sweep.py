@@ -5,6 +5,10 @@ address-space limit (as `ulimit -v 2000000`). Bad input may give an error, never
 abort, a hang (20 s) or more than 200 MB of memory.
 
     tools/sweep.py EENF_BINARY FIXTURES_DIR [--flips 300] [--cuts 200] [--jobs 2]
+    tools/sweep.py EENF_BINARY --audio [--flips 200] [--cuts 100]
+
+With --audio, the seeds are 20 s of mains hum with noise encoded by ffmpeg in seven containers
+(WAV, FLAC, MP3, M4A/AAC, OGG/Vorbis, MKV, WebM/Opus), and each copy goes through `audio`.
 
 Prints the counts and exits non-zero on any panic, abort, timeout or memory overrun. Each
 child's peak memory is its own (wait4), not the sweep's.
@@ -24,11 +28,40 @@ from concurrent.futures import ThreadPoolExecutor
 LIMIT_AS = 2_000_000 * 1024  # ulimit -v 2000000 (KiB)
 TIMEOUT_S = 20
 MAX_RSS_MB = 200
-COMMANDS = {
+EVENT_COMMANDS = {
     "info": ["info"],
     "extract": ["extract"],
     "extract-fine": ["extract", "--window", "0.02", "--step", "0.01", "--dt-us", "100"],
 }
+AUDIO_COMMANDS = {"audio": ["audio"]}
+COMMANDS = EVENT_COMMANDS
+# container: ffmpeg's encoding arguments
+AUDIO_SEEDS = {
+    "wav": ["-c:a", "pcm_s16le"],
+    "flac": ["-c:a", "flac"],
+    "mp3": ["-c:a", "libmp3lame", "-b:a", "64k"],
+    "m4a": ["-c:a", "aac", "-b:a", "64k"],
+    "ogg": ["-c:a", "libvorbis"],
+    "mkv": ["-c:a", "flac"],
+    "webm": ["-c:a", "libopus", "-b:a", "48k"],
+}
+
+
+def audio_seeds(work):
+    """20 s of a 50 Hz hum and its harmonics in noise, in each container of AUDIO_SEEDS."""
+    hum = "0.2*sin(2*PI*50*t)+0.05*sin(2*PI*100*t)+0.03*sin(2*PI*150*t)"
+    paths = []
+    for ext, codec in AUDIO_SEEDS.items():
+        out = os.path.join(work, f"seed.{ext}")
+        src = f"aevalsrc={hum}:s=8000:d=20"
+        cmd = ["ffmpeg", "-v", "error", "-y", "-f", "lavfi", "-i", src, "-f", "lavfi", "-i",
+               "anoisesrc=a=0.02:d=20:r=8000", "-filter_complex", "amix=inputs=2", "-ar",
+               "48000" if ext == "webm" else "8000", *codec, out]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode != 0:
+            sys.exit(f"ffmpeg could not make the {ext} seed: {r.stderr.strip()}")
+        paths.append(out)
+    return paths
 
 
 def limit():
@@ -39,7 +72,9 @@ def run(binary, cmd, path, errdir):
     """Runs one command; returns (outcome, peak_mb, detail)."""
     with tempfile.TemporaryFile(dir=errdir) as err:
         p = subprocess.Popen(
-            [binary, "--quiet", *COMMANDS[cmd], path],
+            # the file goes where the command has "{}", else last
+            [binary, "--quiet", *([a.replace("{}", path) for a in COMMANDS[cmd]]
+                                  if "{}" in COMMANDS[cmd] else [*COMMANDS[cmd], path])],
             stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,
             stderr=err,
@@ -87,18 +122,25 @@ def variants(data, rng, cuts, flips):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("binary")
-    ap.add_argument("fixtures")
+    ap.add_argument("fixtures", nargs="?")
+    ap.add_argument("--audio", action="store_true", help="sweep sound files through `audio`")
     ap.add_argument("--cuts", type=int, default=200)
     ap.add_argument("--flips", type=int, default=300)
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
     ap.add_argument("--seed", type=int, default=2026)
     a = ap.parse_args()
-    files = sorted(
-        os.path.join(d, f)
-        for d, _, fs in os.walk(a.fixtures)
-        for f in fs
-        if not f.endswith((".md", ".json", ".npy")) and f != "LICENSE"
-    )
+    global COMMANDS
+    seeds = tempfile.TemporaryDirectory()
+    if a.audio:
+        COMMANDS = AUDIO_COMMANDS
+        files = audio_seeds(seeds.name)
+    else:
+        files = sorted(
+            os.path.join(d, f)
+            for d, _, fs in os.walk(a.fixtures)
+            for f in fs
+            if not f.endswith((".md", ".json", ".npy")) and f != "LICENSE"
+        )
     counts = {}
     worst = {}
     bad = []

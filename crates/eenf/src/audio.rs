@@ -128,10 +128,18 @@ impl Sink {
 /// sound is an error.
 pub fn read_audio(path: &Path, opts: &AudioOptions) -> Result<Audio> {
     let mut file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
-    if is_matroska(&mut file) {
+    match container_of(&mut file) {
         // Symphonia's Matroska reader panics on cut-short files and allocates whatever a lace
         // size says (0.5.5): MKV and WebM go to ffmpeg, which reads them robustly
-        return read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {e}", path.display()));
+        Container::Matroska => {
+            return read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {e}", path.display()))
+        }
+        // its MP4 reader can allocate from damaged box sizes past the memory there is (an
+        // abort no panic guard catches): MP4 goes to ffmpeg where it is installed
+        Container::Mp4 if ffmpeg_installed() => {
+            return read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {e}", path.display()))
+        }
+        _ => {}
     }
     // a panic inside Symphonia (damaged data it does not check) is the file's error, and
     // ffmpeg is asked next as for a format Symphonia does not read
@@ -146,12 +154,39 @@ pub fn read_audio(path: &Path, opts: &AudioOptions) -> Result<Audio> {
     }
 }
 
-/// Whether `file` starts with the EBML magic of Matroska and WebM; the file is left at its start.
-fn is_matroska(file: &mut std::fs::File) -> bool {
+/// Containers whose Symphonia readers are not trusted with damaged files.
+#[derive(PartialEq)]
+enum Container {
+    /// Matroska and WebM (EBML magic).
+    Matroska,
+    /// ISO base media: MP4, M4A, MOV (`ftyp` box first).
+    Mp4,
+    /// Anything else.
+    Other,
+}
+
+/// The container `file` starts with; the file is left at its start.
+fn container_of(file: &mut std::fs::File) -> Container {
     use std::io::{Seek, SeekFrom};
-    let mut head = [0u8; 4];
-    let matroska = file.read_exact(&mut head).is_ok() && head == [0x1A, 0x45, 0xDF, 0xA3];
-    file.seek(SeekFrom::Start(0)).is_ok() && matroska
+    let mut head = [0u8; 8];
+    let read = file.read_exact(&mut head).is_ok();
+    let rewound = file.seek(SeekFrom::Start(0)).is_ok();
+    match head {
+        _ if !(read && rewound) => Container::Other,
+        [0x1A, 0x45, 0xDF, 0xA3, ..] => Container::Matroska,
+        [_, _, _, _, b'f', b't', b'y', b'p'] => Container::Mp4,
+        _ => Container::Other,
+    }
+}
+
+/// Whether the ffmpeg programs are there to be run.
+fn ffmpeg_installed() -> bool {
+    Command::new("ffprobe")
+        .arg("-version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
 }
 
 /// A recording's sound: a file (any format [`read_audio`] reads), or samples already in

@@ -1,9 +1,18 @@
 //! The reference store: one time-indexed ENF series per grid, kept as 32-bit integers
 //! (µHz deviation from the nominal frequency; a year at 1 s is 126 MB), gaps kept as gaps.
 //!
-//! Layout: `DIR/<grid>.json` (metadata) and `DIR/<grid>.i32` (little-endian values, one per
-//! step from `start_unix_s`; `i32::MIN` marks a gap).
+//! Layout: `DIR/<grid>.json`, the grid's manifest (metadata, the name of its values file and
+//! the values' CRC-32), and the values file it names, `DIR/<grid>.<generation>.i32`
+//! (little-endian values, one per step from `start_unix_s`; `i32::MIN` marks a gap). Stores
+//! written before generations (no `values_file`) keep their values in `DIR/<grid>.i32`.
+//!
+//! A change commits in one atomic step: the new values go to a new file, then the manifest is
+//! renamed over the old one, then the old values file is removed. A kill at any moment leaves
+//! the old store or the new one. Builds hold an exclusive lock on `DIR/.eenf-store.lock` for
+//! their whole read-merge-write, so that two builds into one store follow each other; readers
+//! take it shared.
 
+use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -14,6 +23,8 @@ use crate::output::write_atomic;
 pub const GAP: i32 = i32::MIN;
 /// Longest series accepted: ten years at 1 s.
 const MAX_VALUES: usize = 10 * 366 * 86_400;
+/// The lock file of a store.
+const LOCK_FILE: &str = ".eenf-store.lock";
 
 /// Metadata of one grid's series.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -30,6 +41,12 @@ pub struct RefMeta {
     pub count: usize,
     /// How values are stored.
     pub encoding: String,
+    /// The file (in the store) that holds the values; `<grid>.i32` when absent (older stores).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub values_file: Option<String>,
+    /// CRC-32 (IEEE) of the values file's bytes; absent in older stores.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub values_crc32: Option<u32>,
 }
 
 /// One grid's series in memory.
@@ -41,11 +58,87 @@ pub struct RefSeries {
     pub values: Vec<i32>,
 }
 
-fn paths(dir: &Path, grid: &str) -> (PathBuf, PathBuf) {
-    (
-        dir.join(format!("{grid}.json")),
-        dir.join(format!("{grid}.i32")),
-    )
+/// A store's lock, held until dropped.
+pub struct StoreLock(#[allow(dead_code)] Option<File>);
+
+impl StoreLock {
+    /// The exclusive lock of the store at `dir` (created if need be), for a change. When
+    /// another process holds it, waits for it, or with `wait` false fails saying so.
+    pub fn exclusive(dir: &Path, wait: bool) -> Result<Self> {
+        std::fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
+        let path = dir.join(LOCK_FILE);
+        let file = File::options()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .with_context(|| format!("{}", path.display()))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) if wait => {
+                eprintln!(
+                    "{}: another build is changing this store; waiting for it",
+                    dir.display()
+                );
+                file.lock().with_context(|| format!("{}", path.display()))?;
+            }
+            Err(std::fs::TryLockError::WouldBlock) => bail!(
+                "{}: another build is changing this store (without --no-wait, this one waits)",
+                dir.display()
+            ),
+            Err(std::fs::TryLockError::Error(e)) => {
+                return Err(e).with_context(|| format!("{}", path.display()))
+            }
+        }
+        Ok(StoreLock(Some(file)))
+    }
+
+    /// The shared lock of the store at `dir`, for reading: a build's commit cannot remove a
+    /// values file while it is read. A store that cannot hold a lock file (read-only) is read
+    /// without one.
+    pub fn shared(dir: &Path) -> Result<Self> {
+        let path = dir.join(LOCK_FILE);
+        let file = File::options()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .or_else(|_| File::open(&path));
+        let Ok(file) = file else {
+            return Ok(StoreLock(None));
+        };
+        file.lock_shared()
+            .with_context(|| format!("{}", path.display()))?;
+        Ok(StoreLock(Some(file)))
+    }
+}
+
+/// Refuses a grid name that is not a plain name: it becomes file names in the store, and a
+/// store's metadata must not make a build write elsewhere (`../x`, `/abs`).
+pub fn check_grid_name(grid: &str) -> Result<()> {
+    let plain = !grid.is_empty()
+        && grid.len() <= 64
+        && grid
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+        && !grid.starts_with('-');
+    if !plain {
+        bail!(
+            "{grid:?} is not a grid name: letters, digits, _ and - only (at most 64), e.g. grid50"
+        );
+    }
+    Ok(())
+}
+
+fn manifest(dir: &Path, grid: &str) -> PathBuf {
+    dir.join(format!("{grid}.json"))
+}
+
+/// The CRC-32 of values as the store writes them.
+fn crc_of(bytes: &[u8]) -> u32 {
+    let mut h = crc32fast::Hasher::new();
+    h.update(bytes);
+    h.finalize()
 }
 
 impl RefSeries {
@@ -60,49 +153,93 @@ impl RefSeries {
                 count: 0,
                 encoding: "i32 little-endian, µHz deviation from nominal_hz, -2147483648 = gap"
                     .into(),
+                values_file: None,
+                values_crc32: None,
             },
             values: Vec::new(),
         }
     }
 
-    /// The grids stored in `dir`.
+    /// The grids stored in `dir` (the names of their manifests).
     pub fn grids(dir: &Path) -> Result<Vec<String>> {
         let mut out = Vec::new();
         for e in std::fs::read_dir(dir).with_context(|| format!("{}", dir.display()))? {
             let p = e?.path();
-            if p.extension().and_then(|e| e.to_str()) == Some("json")
-                && p.with_extension("i32").exists()
-            {
-                out.push(p.file_stem().unwrap().to_string_lossy().into_owned());
+            if p.extension().and_then(|e| e.to_str()) == Some("json") {
+                let stem = p.file_stem().unwrap_or_default().to_string_lossy();
+                if check_grid_name(&stem).is_ok() {
+                    out.push(stem.into_owned());
+                }
             }
         }
         out.sort();
         Ok(out)
     }
 
-    /// Reads one grid's metadata.
+    /// Reads one grid's manifest; a grid name in it that is not the manifest's own is damage.
     pub fn load_meta(dir: &Path, grid: &str) -> Result<RefMeta> {
-        let (json, _) = paths(dir, grid);
+        check_grid_name(grid)?;
+        let json = manifest(dir, grid);
         let text = std::fs::read_to_string(&json).with_context(|| format!("{}", json.display()))?;
-        serde_json::from_str(&text)
-            .with_context(|| format!("{}: not an eenf reference store", json.display()))
+        let meta: RefMeta = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not an eenf reference store", json.display()))?;
+        if meta.grid != grid {
+            bail!(
+                "{}: names grid {:?}, but it is the manifest of {grid:?}: the store is damaged \
+                 or was edited by hand",
+                json.display(),
+                meta.grid
+            );
+        }
+        if !(meta.step_s.is_finite() && meta.step_s > 0.0 && meta.start_unix_s.is_finite()) {
+            bail!("{}: a damaged manifest (step or start)", json.display());
+        }
+        Ok(meta)
     }
 
-    /// Loads one grid.
+    /// The values file a manifest names (a plain file name in the store).
+    fn values_path(dir: &Path, meta: &RefMeta) -> Result<PathBuf> {
+        let name = meta
+            .values_file
+            .clone()
+            .unwrap_or_else(|| format!("{}.i32", meta.grid));
+        if name.contains(['/', '\\']) || name.starts_with('.') {
+            bail!(
+                "{}: names {name:?} as its values, not a file of the store",
+                manifest(dir, &meta.grid).display()
+            );
+        }
+        Ok(dir.join(name))
+    }
+
+    /// Loads one grid, checking the values against the manifest's count and checksum.
     pub fn load(dir: &Path, grid: &str) -> Result<Self> {
         let meta = Self::load_meta(dir, grid)?;
-        let (_, data) = paths(dir, grid);
+        let data = Self::values_path(dir, &meta)?;
         let len = std::fs::metadata(&data)
             .with_context(|| format!("{}", data.display()))?
             .len();
         if len != meta.count as u64 * 4 || meta.count > MAX_VALUES {
             bail!(
-                "{}: {len} bytes where the metadata announces {} values",
+                "{}: {len} bytes where the manifest announces {} values: the store was damaged \
+                 (a build interrupted before eenf committed its changes atomically); build this \
+                 grid again from its sources",
                 data.display(),
                 meta.count
             );
         }
         let bytes = std::fs::read(&data).with_context(|| format!("{}", data.display()))?;
+        if let Some(want) = meta.values_crc32 {
+            let got = crc_of(&bytes);
+            if got != want {
+                bail!(
+                    "{}: the values do not match their checksum (CRC-32 {got:08x}, the manifest \
+                     says {want:08x}): they were damaged on disk; build this grid again from its \
+                     sources",
+                    data.display()
+                );
+            }
+        }
         let values = bytes
             .chunks_exact(4)
             .map(|c| i32::from_le_bytes(c.try_into().unwrap()))
@@ -110,26 +247,70 @@ impl RefSeries {
         Ok(RefSeries { meta, values })
     }
 
-    /// Writes both files (each whole or not at all).
+    /// Commits the series: a new values file, then the manifest that names it renamed over
+    /// the old one (the commit), then the old values file removed. Call it under
+    /// [`StoreLock::exclusive`].
     pub fn save(&mut self, dir: &Path) -> Result<()> {
+        check_grid_name(&self.meta.grid)?;
         std::fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
-        self.meta.count = self.values.len();
-        let (json, data) = paths(dir, &self.meta.grid);
+        let json = manifest(dir, &self.meta.grid);
+        let old = Self::load_meta(dir, &self.meta.grid)
+            .ok()
+            .and_then(|m| Self::values_path(dir, &m).ok());
+        let mut bytes = Vec::with_capacity(self.values.len() * 4);
+        for v in &self.values {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        // a new name for every commit: the old file stays whole until the manifest moves on
+        let stamp = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos())
+            .unwrap_or(0);
+        let name = format!("{}.{stamp:x}.{}.i32", self.meta.grid, std::process::id());
+        let data = dir.join(&name);
         write_atomic(&data, |w| {
-            let mut buf = Vec::with_capacity(1 << 20);
-            for chunk in self.values.chunks(1 << 18) {
-                buf.clear();
-                for v in chunk {
-                    buf.extend_from_slice(&v.to_le_bytes());
-                }
-                w.write_all(&buf)?;
-            }
+            w.write_all(&bytes)?;
             Ok(())
         })?;
+        File::open(&data)
+            .and_then(|f| f.sync_all())
+            .with_context(|| format!("{}", data.display()))?;
+        self.meta.count = self.values.len();
+        self.meta.values_file = Some(name);
+        self.meta.values_crc32 = Some(crc_of(&bytes));
         write_atomic(&json, |w| {
             serde_json::to_writer_pretty(&mut *w, &self.meta)?;
             Ok(())
-        })
+        })?;
+        if let Ok(d) = File::open(dir) {
+            let _ = d.sync_all();
+        }
+        if let Some(old) = old.filter(|o| *o != data) {
+            let _ = std::fs::remove_file(old);
+        }
+        Ok(())
+    }
+
+    /// Removes values files of `grid` that its manifest does not name (left by builds killed
+    /// before their commit). Call it under [`StoreLock::exclusive`].
+    pub fn remove_orphans(dir: &Path, grid: &str) -> Result<usize> {
+        let named = Self::load_meta(dir, grid)
+            .ok()
+            .and_then(|m| Self::values_path(dir, &m).ok());
+        let prefix = format!("{grid}.");
+        let mut removed = 0;
+        for e in std::fs::read_dir(dir).with_context(|| format!("{}", dir.display()))? {
+            let p = e?.path();
+            let file = p.file_name().unwrap_or_default().to_string_lossy();
+            let generation = file
+                .strip_prefix(&prefix)
+                .and_then(|r| r.strip_suffix(".i32"))
+                .is_some_and(|g| g.contains('.'));
+            if generation && Some(&p) != named.as_ref() && std::fs::remove_file(&p).is_ok() {
+                removed += 1;
+            }
+        }
+        Ok(removed)
     }
 
     /// Values in Hz, NaN for gaps.
@@ -207,5 +388,55 @@ mod tests {
         assert!((hz[2] - 50.01).abs() < 1e-9 && (hz[3] - 49.99).abs() < 1e-9 && hz[4].is_nan());
         assert!((hz[13] - 50.001).abs() < 1e-9, "{hz:?}");
         assert_eq!(RefSeries::grids(dir.path()).unwrap(), vec!["g".to_string()]);
+    }
+
+    #[test]
+    fn commits_replace_values_files_and_damage_is_found() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let mut s = RefSeries::new("grid50", 50.0, 1.0, 1000.0);
+        s.merge(1000.0, 1.0, &[50.01, 49.99, 50.0]).unwrap();
+        s.save(d).unwrap();
+        let first = s.meta.values_file.clone().unwrap();
+        s.merge(1003.0, 1.0, &[50.02]).unwrap();
+        s.save(d).unwrap();
+        let second = s.meta.values_file.clone().unwrap();
+        // the commit moved to a new values file and removed the old one
+        assert_ne!(first, second);
+        assert!(!d.join(&first).exists() && d.join(&second).exists());
+        assert_eq!(RefSeries::load(d, "grid50").unwrap().values.len(), 4);
+        // a file left by a build killed before its commit is not the store's, and is cleaned
+        std::fs::write(d.join("grid50.1.2.i32"), [0u8; 8]).unwrap();
+        assert_eq!(RefSeries::remove_orphans(d, "grid50").unwrap(), 1);
+        assert!(d.join(&second).exists());
+        // a flipped bit in the values is found by the checksum
+        let mut bytes = std::fs::read(d.join(&second)).unwrap();
+        bytes[5] ^= 0x10;
+        std::fs::write(d.join(&second), &bytes).unwrap();
+        let e = RefSeries::load(d, "grid50").unwrap_err().to_string();
+        assert!(e.contains("checksum"), "{e}");
+    }
+
+    #[test]
+    fn grid_names_are_plain_names() {
+        for ok in ["grid50", "GB-2024", "a_b"] {
+            assert!(check_grid_name(ok).is_ok(), "{ok}");
+        }
+        for bad in ["", "../x", "/abs/path", "a/b", "a.b", "-x", &"g".repeat(65)] {
+            assert!(check_grid_name(bad).is_err(), "{bad}");
+        }
+        // a manifest that names another grid (or a path) is refused, and nothing is written
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path().join("store");
+        std::fs::create_dir(&d).unwrap();
+        std::fs::write(
+            d.join("grid50.json"),
+            r#"{"grid": "../escaped", "nominal_hz": 50.0, "step_s": 1.0, "start_unix_s": 0.0,
+                "count": 0, "encoding": "i32"}"#,
+        )
+        .unwrap();
+        let e = RefSeries::load(&d, "grid50").unwrap_err().to_string();
+        assert!(e.contains("../escaped"), "{e}");
+        assert!(!dir.path().join("escaped.json").exists());
     }
 }

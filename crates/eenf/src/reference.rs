@@ -382,6 +382,7 @@ impl ReferenceSeries {
         if path.is_dir() {
             let grids = RefSeries::grids(path)?;
             if !grids.is_empty() {
+                let _lock = crate::refdb::StoreLock::shared(path)?;
                 let mut out = Vec::new();
                 for g in grids {
                     let meta = RefSeries::load_meta(path, &g)?;

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use eenf::extract::Nominal;
 use eenf::progress::Progress;
-use eenf::refdb::{RefSeries, GAP};
+use eenf::refdb::{check_grid_name, RefSeries, StoreLock, GAP};
 use eenf::reference::{reference_file, wav_start};
 use eenf::time::{parse_time, tz_offset, utc};
 use eenf::trace::Trace;
@@ -45,6 +45,9 @@ pub struct BuildArgs {
     /// Start time of the first trace CSV (UTC, or with an offset).
     #[arg(long)]
     pub start: Option<String>,
+    /// Fail at once when another build is changing the store, instead of waiting for it.
+    #[arg(long)]
+    pub no_wait: bool,
     /// Seconds between values of `index` CSVs.
     #[arg(long, value_parser = eenf::args::number_in(0.001, 3600.0))]
     pub step: Option<f64>,
@@ -52,6 +55,11 @@ pub struct BuildArgs {
 
 fn build(a: BuildArgs, progress: Progress) -> Result<()> {
     let tz = a.tz.as_deref().map(tz_offset).transpose()?;
+    if let Some(g) = &a.grid {
+        check_grid_name(g)?;
+    }
+    // the whole read-merge-write under the store's lock: a second build waits for this one
+    let _lock = StoreLock::exclusive(&a.store, !a.no_wait)?;
     let bar = progress.steps(a.inputs.len() as u64, "adding references");
     let mut series: Vec<RefSeries> = Vec::new();
     let mut next_start = a.start.as_deref().map(parse_time).transpose()?;
@@ -106,6 +114,7 @@ fn build(a: BuildArgs, progress: Progress) -> Result<()> {
     bar.finish_and_clear();
     for s in &mut series {
         s.save(&a.store)?;
+        RefSeries::remove_orphans(&a.store, &s.meta.grid)?;
         eprintln!(
             "{}: grid {} now holds {} values",
             a.store.display(),
@@ -113,6 +122,7 @@ fn build(a: BuildArgs, progress: Progress) -> Result<()> {
             s.values.len()
         );
     }
+    drop(_lock);
     info(&a.store)
 }
 
@@ -121,6 +131,7 @@ fn info(store: &Path) -> Result<()> {
     if grids.is_empty() {
         bail!("{}: no reference series here", store.display());
     }
+    let _lock = StoreLock::shared(store)?;
     for g in grids {
         let s = RefSeries::load(store, &g)?;
         let m = &s.meta;
@@ -145,6 +156,13 @@ fn info(store: &Path) -> Result<()> {
             runs
         );
         outln!("size        {:.1} MB", s.values.len() as f64 * 4.0 / 1e6);
+        outln!(
+            "checksum    {}",
+            match m.values_crc32 {
+                Some(c) => format!("CRC-32 {c:08x}, verified"),
+                None => "none (a store written before checksums; build it again to add one)".into(),
+            }
+        );
         outln!();
     }
     Ok(())
