@@ -6,6 +6,7 @@ mod cli;
 
 use std::f64::consts::PI;
 use std::path::Path;
+use std::process::Command;
 
 use cli::{fails, json, ok};
 use eenf_dsp::{agreement, reference_enf, EnfParams};
@@ -222,4 +223,56 @@ fn other_formats_give_the_wavs_trace() {
         .collect();
     let n = t.len().min(wav.len());
     assert!(agreement(&t[..n], &wav[..n]).unwrap().mae_hz < 5e-4);
+}
+
+/// No trace without a line: sound that holds no mains hum is refused, not traced at the edges
+/// of the search bands. Noise, a 7 Hz square wave (its odd harmonics at 49 and 63 Hz), a steady
+/// tone 0.7 Hz below 50 Hz and one 1.2 Hz above 60 Hz, at telephone and mains-logger rates.
+#[test]
+fn sound_without_mains_hum_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, fs: u32, f: &dyn Fn(f64, u32) -> f64| {
+        let path = dir.path().join(name);
+        let spec = hound::WavSpec {
+            channels: 1,
+            sample_rate: fs,
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+        };
+        let mut w = hound::WavWriter::create(&path, spec).unwrap();
+        let mut state = 99u64;
+        for i in 0..fs * 40 {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let noise = ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.1;
+            let v = f(i as f64 / fs as f64, i) + noise;
+            w.write_sample((v.clamp(-1.0, 1.0) * 32000.0) as i16)
+                .unwrap();
+        }
+        w.finalize().unwrap();
+        path
+    };
+    let tau = std::f64::consts::TAU;
+    let cases = [
+        write("noise.wav", 8000, &|_, _| 0.0),
+        write("square7.wav", 400, &|t, _| {
+            0.5 * (tau * 7.0 * t).sin().signum()
+        }),
+        write("tone49_3.wav", 8000, &|t, _| 0.3 * (tau * 49.3 * t).sin()),
+        write("tone61_2.wav", 8000, &|t, _| 0.3 * (tau * 61.2 * t).sin()),
+    ];
+    for path in cases {
+        let out = Command::new(env!("CARGO_BIN_EXE_eenf"))
+            .args(["-q", "audio"])
+            .arg(&path)
+            .args(["-o"])
+            .arg(path.with_extension("csv"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{}: traced", path.display());
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(!path.with_extension("csv").exists(), "{}", path.display());
+    }
 }
