@@ -172,18 +172,8 @@ fn a_file_without_data_table_reads_to_the_end() {
     write(&path, Compression::Zstd, &events);
     // Drop the table and set the header's dataTablePosition to -1, as an interrupted recording
     // leaves the file.
-    let mut bytes = std::fs::read(&path).unwrap();
-    let info = open(&path).unwrap().info().clone();
-    assert!(info.indexed);
-    let hlen = u32::from_le_bytes(bytes[14..18].try_into().unwrap()) as usize;
-    let table_pos = find_table_pos(&bytes, hlen);
-    bytes.truncate(table_pos as usize);
-    let needle = table_pos.to_le_bytes();
-    let at = bytes[18..18 + hlen]
-        .windows(8)
-        .position(|w| w == needle)
-        .unwrap();
-    bytes[18 + at..18 + at + 8].copy_from_slice(&(-1i64).to_le_bytes());
+    assert!(open(&path).unwrap().info().indexed);
+    let bytes = without_table(&path);
     std::fs::write(&path, &bytes).unwrap();
     let r = open(&path).unwrap();
     assert!(!r.info().indexed);
@@ -273,15 +263,9 @@ fn a_wild_timestamp_ends_the_stream_where_it_is() {
     assert_eq!(r.damage().unwrap().kind, DamageKind::TimeJump);
 }
 
-/// `events` written as ZSTD without an index, then `packet` (a compressed body) appended as a
-/// further packet of the event stream.
-fn with_extra_packet(
-    path: &std::path::Path,
-    codec: Compression,
-    events: &EventBatch,
-    packet: &[u8],
-) {
-    write(path, codec, events);
+/// The bytes of the AEDAT4 file at `path` without its FileDataTable, the header's
+/// dataTablePosition set to -1.
+fn without_table(path: &std::path::Path) -> Vec<u8> {
     let mut bytes = std::fs::read(path).unwrap();
     let hlen = u32::from_le_bytes(bytes[14..18].try_into().unwrap()) as usize;
     let table_pos = find_table_pos(&bytes, hlen);
@@ -292,6 +276,19 @@ fn with_extra_packet(
         .position(|w| w == needle)
         .unwrap();
     bytes[18 + at..18 + at + 8].copy_from_slice(&(-1i64).to_le_bytes());
+    bytes
+}
+
+/// `events` written without an index, then `packet` (a compressed body) appended as a further
+/// packet of the event stream.
+fn with_extra_packet(
+    path: &std::path::Path,
+    codec: Compression,
+    events: &EventBatch,
+    packet: &[u8],
+) {
+    write(path, codec, events);
+    let mut bytes = without_table(path);
     bytes.extend_from_slice(&0i32.to_le_bytes());
     bytes.extend_from_slice(&(packet.len() as i32).to_le_bytes());
     bytes.extend_from_slice(packet);

@@ -67,12 +67,7 @@ impl StoreLock {
     pub fn exclusive(dir: &Path, wait: bool) -> Result<Self> {
         std::fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
         let path = dir.join(LOCK_FILE);
-        let file = File::options()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&path)
-            .with_context(|| format!("{}", path.display()))?;
+        let file = open_lock_file(&path).with_context(|| format!("{}", path.display()))?;
         match file.try_lock() {
             Ok(()) => {}
             Err(std::fs::TryLockError::WouldBlock) if wait => {
@@ -98,12 +93,7 @@ impl StoreLock {
     /// without one.
     pub fn shared(dir: &Path) -> Result<Self> {
         let path = dir.join(LOCK_FILE);
-        let file = File::options()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&path)
-            .or_else(|_| File::open(&path));
+        let file = open_lock_file(&path).or_else(|_| File::open(&path));
         let Ok(file) = file else {
             return Ok(StoreLock(None));
         };
@@ -111,6 +101,15 @@ impl StoreLock {
             .with_context(|| format!("{}", path.display()))?;
         Ok(StoreLock(Some(file)))
     }
+}
+
+/// The lock file, created when missing (never truncated: it holds nothing).
+fn open_lock_file(path: &Path) -> std::io::Result<File> {
+    File::options()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(path)
 }
 
 /// Refuses a grid name that is not a plain name: it becomes file names in the store, and a
