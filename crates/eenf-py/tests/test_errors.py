@@ -81,7 +81,7 @@ def test_bad_samples_and_parameters(sim, tmp_path):
         eenf.reference(x)
     with pytest.raises(ValueError, match="unexpected argument '--windoww'"):
         eenf.extract(sim.recording, windoww=8)
-    with pytest.raises(ValueError, match="must be positive"):
+    with pytest.raises(ValueError, match=r"--window.*outside 0.05..=3600"):
         eenf.extract(sim.recording, window=-1.0)
     with pytest.raises(ValueError, match="invalid value 'nope'"):
         eenf.extract(sim.recording, sampling="nope")
@@ -90,3 +90,23 @@ def test_bad_samples_and_parameters(sim, tmp_path):
     with pytest.raises(ValueError):
         eenf.write_events(tmp_path / "a.unknown", events())
     assert not (tmp_path / "a.unknown").exists()
+
+
+def test_absurd_numbers_raise_value_errors(sim, tmp_path):
+    """Numbers that once killed the interpreter or never returned (fs=1e12, fs=1e300) or
+    raised PanicException (top=2**64-1) are ValueErrors naming the range."""
+    hum = np.sin(2 * np.pi * 50 * np.arange(4000) / 400.0)
+    for fs in [1e12, 1e300, 0.0, -5.0, float("nan"), float("inf")]:
+        with pytest.raises(ValueError, match="sample rate"):
+            eenf.reference(hum, fs=fs)
+    trace = tmp_path / "t.csv"
+    trace.write_text("time_s,enf_hz\n" + "".join(f"{i},{50 + 0.001 * (i % 5)}\n" for i in range(60)))
+    for top in [2**64 - 1, 10**9, 0]:
+        with pytest.raises(ValueError, match="top"):
+            eenf.match(trace, trace, top=top)
+    with pytest.raises(ValueError, match="median"):
+        eenf.extract(sim.recording, median_len=10**9)
+    bad = tmp_path / "ns.csv"
+    bad.write_text("time_s,enf_hz\n" + "".join(f"{i}e-9,50.0\n" for i in range(60)))
+    with pytest.raises(ValueError, match="s apart"):
+        eenf.Trace.read(bad)

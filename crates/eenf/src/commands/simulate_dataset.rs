@@ -269,5 +269,10 @@ fn build(
         secs,
         a.out_dir.display()
     );
+    // the names carry local times without their zone, as the data set's do: say which
+    eprintln!(
+        "file names are in local time at UTC{} (--tz; give the same to `match` and `refdb build`)",
+        a.tz
+    );
     Ok(())
 }
