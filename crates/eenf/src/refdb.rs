@@ -179,6 +179,13 @@ impl RefSeries {
     pub fn load_meta(dir: &Path, grid: &str) -> Result<RefMeta> {
         check_grid_name(grid)?;
         let json = manifest(dir, grid);
+        // a manifest is a few hundred bytes: a large one is not read into memory
+        let size = std::fs::metadata(&json)
+            .with_context(|| format!("{}", json.display()))?
+            .len();
+        if size > 1 << 20 {
+            bail!("{}: {size} bytes: not an eenf reference store manifest", json.display());
+        }
         let text = std::fs::read_to_string(&json).with_context(|| format!("{}", json.display()))?;
         let meta: RefMeta = serde_json::from_str(&text)
             .with_context(|| format!("{}: not an eenf reference store", json.display()))?;

@@ -436,9 +436,7 @@ impl Trace {
     /// Reads a trace file: eenf JSON, a `time_s,enf_hz` CSV, or (with `index_step_s`) an
     /// `index,value` CSV whose values are `index_step_s` apart.
     pub fn read(path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
-        let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
-        let text = read_text_lines(file, path)?;
-        Self::parse(&text, path, index_step_s)
+        Self::parse(&read_text(path)?, path, index_step_s)
     }
 
     /// Parses the text of a trace file named `path` (see [`Trace::read`]).
@@ -612,10 +610,11 @@ const MAX_VALUE: f64 = 1e6;
 /// one value a line).
 const MAX_LINE: u64 = 1 << 20;
 
-/// The text of a trace file, read line by line: a line longer than [`MAX_LINE`] (a binary
-/// file, a sparse file of zeros) is an error before it is held in memory.
-fn read_text_lines(file: std::fs::File, path: &Path) -> Result<String> {
+/// The text of a trace file, read line by line: a line longer than 1 MiB (a binary file, a
+/// sparse file of zeros) is an error before it is held in memory.
+pub fn read_text(path: &Path) -> Result<String> {
     use std::io::BufRead;
+    let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
     let mut r = std::io::BufReader::new(file);
     let mut text = Vec::new();
     let mut line_no = 0usize;

@@ -170,7 +170,7 @@ fn info(store: &Path) -> Result<()> {
 
 /// A trace CSV (`time_s,enf_hz`) or, with `step`, an `index,value` CSV.
 fn read_series(path: &Path, step: Option<f64>) -> Result<Trace> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+    let text = eenf::trace::read_text(path)?;
     let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
     if step.is_none() && !header.contains("time_s") {
         bail!("{}: an index CSV needs --step", path.display());
