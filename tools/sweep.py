@@ -6,15 +6,21 @@ abort, a hang (20 s) or more than 200 MB of memory.
 
     tools/sweep.py EENF_BINARY FIXTURES_DIR [--flips 300] [--cuts 200] [--jobs 2]
     tools/sweep.py EENF_BINARY --audio [--flips 200] [--cuts 100]
+    tools/sweep.py EENF_BINARY --traces [--flips 200] [--cuts 100]
 
 With --audio, the seeds are 20 s of mains hum with noise encoded by ffmpeg in seven containers
 (WAV, FLAC, MP3, M4A/AAC, OGG/Vorbis, MKV, WebM/Opus), and each copy goes through `audio`.
+With --traces, the seeds are a trace CSV, an eenf JSON trace and the two files of a reference
+store (its manifest and its values): damaged traces go through `match` (as the trace and as the
+reference) and `compare`, damaged stores through `refdb info` and `match`.
 
 Prints the counts and exits non-zero on any panic, abort, timeout or memory overrun. Each
 child's peak memory is its own (wait4), not the sweep's.
 """
 import argparse
+import json
 import os
+import shutil
 import random
 import resource
 import signal
@@ -45,6 +51,50 @@ AUDIO_SEEDS = {
     "mkv": ["-c:a", "flac"],
     "webm": ["-c:a", "libopus", "-b:a", "48k"],
 }
+
+
+def trace_seeds(binary, work):
+    """A trace CSV, an eenf JSON trace, and a store built from the CSV: (path, commands)."""
+    import shutil
+    clip = os.path.join(work, "clip.csv")
+    seed_csv = os.path.join(work, "seed.csv")
+    rng = random.Random(5)
+    v, rows = 50.0, []
+    for i in range(900):
+        v += rng.gauss(0, 0.0008) - 0.002 * (v - 50.0)
+        rows.append(f"{i},{v:.6f}\n")
+    with open(seed_csv, "w") as f:
+        f.write("time_s,enf_hz\n" + "".join(rows))
+    with open(clip, "w") as f:
+        f.write("time_s,enf_hz\n" + "".join(f"{i},{r.split(',')[1]}" for i, r in enumerate(rows[300:600])))
+    seed_json = os.path.join(work, "seed.json")
+    out = subprocess.run([binary, "-q", "compare", seed_csv, seed_csv], capture_output=True)
+    trace = json.dumps({"time_s": list(range(900)), "enf_hz": [float(r.split(",")[1]) for r in rows],
+                        "step_s": 1.0, "nominal_hz": 50.0})
+    with open(seed_json, "w") as f:
+        f.write(trace)
+    store = os.path.join(work, "store")
+    r = subprocess.run([binary, "-q", "refdb", "build", store, seed_csv, "--start",
+                        "2022-08-17T08:00:00Z"], capture_output=True, text=True)
+    if r.returncode != 0 or out.returncode != 0:
+        sys.exit(f"could not make the trace seeds: {r.stderr.strip()}")
+    manifest = os.path.join(store, "grid50.json")
+    values = os.path.join(store, json.load(open(manifest))["values_file"])
+    as_trace = {"match-trace": ["match", "{}", seed_csv], "match-reference": ["match", clip, "{}"],
+                "compare": ["compare", "{}", clip]}
+    as_store = {"refdb-info": ["refdb", "info", "{}"], "match-store": ["match", clip, "{}"]}
+
+    def in_store(part):
+        def place(name, body, dest):
+            copy = os.path.join(dest, name)
+            shutil.copytree(store, copy)
+            with open(os.path.join(copy, os.path.basename(part)), "wb") as f:
+                f.write(body)
+            return copy
+        return place
+
+    return [(seed_csv, as_trace, None), (seed_json, as_trace, None),
+            (manifest, as_store, in_store(manifest)), (values, as_store, in_store(values))]
 
 
 def audio_seeds(work):
@@ -124,6 +174,7 @@ def main():
     ap.add_argument("binary")
     ap.add_argument("fixtures", nargs="?")
     ap.add_argument("--audio", action="store_true", help="sweep sound files through `audio`")
+    ap.add_argument("--traces", action="store_true", help="sweep traces and stores through match")
     ap.add_argument("--cuts", type=int, default=200)
     ap.add_argument("--flips", type=int, default=300)
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
@@ -133,30 +184,36 @@ def main():
     seeds = tempfile.TemporaryDirectory()
     if a.audio:
         COMMANDS = AUDIO_COMMANDS
-        files = audio_seeds(seeds.name)
+        files = [(f, AUDIO_COMMANDS, None) for f in audio_seeds(seeds.name)]
+    elif a.traces:
+        files = trace_seeds(a.binary, seeds.name)
+        COMMANDS = {k: v for _, cmds, _ in files for k, v in cmds.items()}
     else:
-        files = sorted(
-            os.path.join(d, f)
-            for d, _, fs in os.walk(a.fixtures)
-            for f in fs
+        files = [
+            (os.path.join(d, f), EVENT_COMMANDS, None)
+            for d, _, fs in sorted(os.walk(a.fixtures))
+            for f in sorted(fs)
             if not f.endswith((".md", ".json", ".npy")) and f != "LICENSE"
-        )
+        ]
     counts = {}
     worst = {}
     bad = []
     peak = 0.0
     started = time.monotonic()
     with tempfile.TemporaryDirectory() as work, ThreadPoolExecutor(a.jobs) as pool:
-        for f in files:
+        for f, commands, place in files:
             data = open(f, "rb").read()
             rng = random.Random(f"{a.seed}:{os.path.basename(f)}")
             ext = os.path.splitext(f)[1]
             jobs = []
             for name, body in variants(data, rng, a.cuts, a.flips):
-                path = os.path.join(work, f"{name}{ext}")
-                with open(path, "wb") as out:
-                    out.write(body)
-                for cmd in COMMANDS:
+                if place:
+                    path = place(name, body, work)
+                else:
+                    path = os.path.join(work, f"{name}{ext}")
+                    with open(path, "wb") as out:
+                        out.write(body)
+                for cmd in commands:
                     jobs.append((name, cmd, pool.submit(run, a.binary, cmd, path, work)))
             for name, cmd, fut in jobs:
                 outcome, mb, detail = fut.result()
@@ -166,7 +223,8 @@ def main():
                 if outcome not in ("ok", "error") or mb > MAX_RSS_MB:
                     bad.append(f"{os.path.basename(f)} {name} {cmd}: {outcome}, {mb:.0f} MB {detail}")
             for name in os.listdir(work):
-                os.remove(os.path.join(work, name))
+                p = os.path.join(work, name)
+                shutil.rmtree(p) if os.path.isdir(p) else os.remove(p)
             print(f"  {os.path.basename(f)}: {len(jobs)} runs", flush=True)
     runs = sum(counts.values())
     summary = ", ".join(f"{v} {k}" for k, v in sorted(counts.items()))
