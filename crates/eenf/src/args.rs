@@ -70,7 +70,7 @@ pub struct TrackerArgs {
     #[arg(long, default_value = "exact", value_parser = one_of::<PeakMethod>(&PeakMethod::NAMES))]
     pub peak: PeakMethod,
     /// STFT window length, s.
-    #[arg(long, default_value_t = 16.0, value_parser = number_in(0.05, 3600.0))]
+    #[arg(long, default_value_t = 16.0, value_parser = number_in(0.01, 3600.0))]
     pub window: f64,
     /// STFT step, s (one estimate per step).
     #[arg(long, default_value_t = 1.0, value_parser = number_in(0.001, 3600.0))]
