@@ -426,7 +426,7 @@ pub struct VideoMethodArgs {
     #[arg(long, default_value = "exact", value_parser = one_of::<PeakMethod>(&PeakMethod::NAMES))]
     pub peak: PeakMethod,
     /// STFT window, s.
-    #[arg(long, default_value_t = 16.0)]
+    #[arg(long, default_value_t = 16.0, value_parser = number_in(0.01, 3600.0))]
     pub window: f64,
 }
 
@@ -488,7 +488,7 @@ pub struct SimulateArgs {
     #[arg(long, default_value_t = 2.0, value_parser = number_in(0.001, 3600.0))]
     pub enf_step: f64,
     /// Grid frequency of a synthetic ENF: 50 or 60 (a WAV's or trace's own is detected).
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(50..=60))]
     pub grid: u32,
     /// Output recording; the format follows the extension (.aedat4, .raw = EVT 3.0, .dat,
     /// .txt) unless --format says. The truth goes beside it as NAME.truth.csv, every

@@ -34,7 +34,7 @@ pub struct Args {
     #[arg(long)]
     pub enf_dir: Option<PathBuf>,
     /// Grid of a synthetic ENF: 50 or 60.
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(50..=60))]
     pub grid: u32,
     /// Local date and hour where a synthetic dataset starts (six hours are covered).
     #[arg(long, default_value = "2022-08-17T16")]
