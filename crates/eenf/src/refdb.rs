@@ -159,18 +159,25 @@ impl RefSeries {
         }
     }
 
-    /// The grids stored in `dir` (the names of their manifests).
+    /// The grids stored in `dir`: manifests `<grid>.json` with a values file `<grid>….i32`
+    /// beside them (other JSON files, e.g. in a folder of hourly WAVs, are not grids).
     pub fn grids(dir: &Path) -> Result<Vec<String>> {
-        let mut out = Vec::new();
+        let mut names = Vec::new();
         for e in std::fs::read_dir(dir).with_context(|| format!("{}", dir.display()))? {
-            let p = e?.path();
-            if p.extension().and_then(|e| e.to_str()) == Some("json") {
-                let stem = p.file_stem().unwrap_or_default().to_string_lossy();
-                if check_grid_name(&stem).is_ok() {
-                    out.push(stem.into_owned());
-                }
-            }
+            names.push(e?.file_name().to_string_lossy().into_owned());
         }
+        let mut out: Vec<String> = names
+            .iter()
+            .filter_map(|n| n.strip_suffix(".json"))
+            .filter(|stem| check_grid_name(stem).is_ok())
+            .filter(|stem| {
+                let prefix = format!("{stem}.");
+                names
+                    .iter()
+                    .any(|n| n.starts_with(&prefix) && n.ends_with(".i32"))
+            })
+            .map(str::to_string)
+            .collect();
         out.sort();
         Ok(out)
     }
@@ -421,6 +428,9 @@ mod tests {
         std::fs::write(d.join(&second), &bytes).unwrap();
         let e = RefSeries::load(d, "grid50").unwrap_err().to_string();
         assert!(e.contains("checksum"), "{e}");
+        // other JSON files beside the grids (a folder of hourly WAVs and their notes) are not grids
+        std::fs::write(d.join("notes.json"), "{}").unwrap();
+        assert_eq!(RefSeries::grids(d).unwrap(), vec!["grid50".to_string()]);
     }
 
     #[test]
