@@ -191,7 +191,10 @@ impl RefSeries {
             .with_context(|| format!("{}", json.display()))?
             .len();
         if size > 1 << 20 {
-            bail!("{}: {size} bytes: not an eenf reference store manifest", json.display());
+            bail!(
+                "{}: {size} bytes: not an eenf reference store manifest",
+                json.display()
+            );
         }
         let text = std::fs::read_to_string(&json).with_context(|| format!("{}", json.display()))?;
         let meta: RefMeta = serde_json::from_str(&text)
