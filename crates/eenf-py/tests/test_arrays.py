@@ -134,6 +134,10 @@ def test_dv_processing_events_in_and_out(sim, shared):
     got = eenf.extract(arr, width=sim.width, height=sim.height)
     assert np.array_equal(got.enf_hz, want.enf_hz, equal_nan=True)
     for f in sorted((shared / "fixtures").rglob("*.aedat4")):
+        # the hostile files' packets decompress to (or claim) 1 GiB: damage to eenf, which
+        # stops at its 64 MiB limit of a packet, where dv-processing reads on
+        if "hostile" in f.parts:
+            continue
         theirs = dv_events(dv, f)
         ours = eenf.read_events(f)
         assert len(ours) == len(theirs), f
