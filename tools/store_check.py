@@ -89,19 +89,24 @@ def main():
             print(f"round {k}: lost {lost}")
     print(f"concurrent builds: {a.rounds} rounds of two, {losses} hours lost, {unreadable} unreadable stores")
     total_losses, total_unreadable = losses, unreadable
-    # 2. kills at random moments
+    # 2. kills at random moments: over the whole length of a build (timed on this machine), so
+    # that some are killed early, some mid-commit and some finish
+    t0 = time.monotonic()
+    run([eenf, "-q", "refdb", "build", str(work / "timing"), str(wavs[0]), "--tz", TZ])
+    per_hour = time.monotonic() - t0
     store = work / "killed"
     committed = []
-    losses = unreadable = 0
+    losses = unreadable = killed = 0
     for k in range(a.kills):
         hours = rng.sample(wavs, rng.randint(1, 3))
         p = subprocess.Popen(
             [eenf, "-q", "refdb", "build", str(store), *map(str, hours), "--tz", TZ],
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        time.sleep(rng.uniform(0, 0.6))
+        time.sleep(rng.uniform(0, 1.3 * per_hour * len(hours)))
         finished = p.poll() is not None
         if not finished:
             p.send_signal(signal.SIGKILL)
+            killed += 1
         rc = p.wait()
         if rc == 0:
             committed = sorted(set(committed) | set(hours))
@@ -111,7 +116,8 @@ def main():
         unreadable += not ok
         if lost or not ok:
             print(f"kill {k}: lost {lost}, readable {ok}")
-    print(f"killed builds: {a.kills} kills, {len(committed)} hours committed, {losses} losses, {unreadable} unreadable stores")
+    print(f"killed builds: {a.kills} builds, {killed} killed mid-build, {len(committed)} hours "
+          f"committed, {losses} losses, {unreadable} unreadable stores")
     total_losses += losses
     total_unreadable += unreadable
     # 3. a manifest that names a path
