@@ -117,31 +117,31 @@ def main():
     rng = random.Random(a.seed)
     work = tempfile.mkdtemp(prefix="eenf-false-alarms-")
     rows, alarms = [], []
-    for kind, make in audio_kinds(rng).items():
+
+    def try_kind(kind, command, ext, write):
+        """`each` negatives of one kind, written by write(path, i), through `command`."""
         traced = 0
         for i in range(a.each):
+            path = os.path.join(work, f"{kind.replace(' ', '_')}_{i}.{ext}")
+            write(path, i)
+            out = path + ".csv"
+            r = subprocess.run([a.eenf, "-q", command, path, "-o", out], capture_output=True, text=True)
+            if r.returncode == 0 or os.path.exists(out):
+                traced += 1
+                alarms.append(f"{kind} #{i}: {r.stderr.strip()}")
+            os.remove(path)
+        rows.append((kind, traced, a.each))
+
+    def wav_of(make):
+        def write(path, i):
             fs = [8000, 44100][i % 2]
-            path = os.path.join(work, f"{kind.replace(' ', '_')}_{i}.wav")
             write_wav(path, fs, make(fs, fs * 40))
-            out = path + ".csv"
-            r = subprocess.run([a.eenf, "-q", "audio", path, "-o", out], capture_output=True, text=True)
-            if r.returncode == 0 or os.path.exists(out):
-                traced += 1
-                alarms.append(f"{kind} #{i}: {r.stderr.strip()}")
-            os.remove(path)
-        rows.append((kind, traced, a.each))
+        return write
+
+    for kind, make in audio_kinds(rng).items():
+        try_kind(kind, "audio", "wav", wav_of(make))
     for kind, make in event_kinds(rng).items():
-        traced = 0
-        for i in range(a.each):
-            path = os.path.join(work, f"{kind.replace(' ', '_')}_{i}.txt")
-            make(path)
-            out = path + ".csv"
-            r = subprocess.run([a.eenf, "-q", "extract", path, "-o", out], capture_output=True, text=True)
-            if r.returncode == 0 or os.path.exists(out):
-                traced += 1
-                alarms.append(f"{kind} #{i}: {r.stderr.strip()}")
-            os.remove(path)
-        rows.append((kind, traced, a.each))
+        try_kind(kind, "extract", "txt", lambda path, i, make=make: make(path))
     print(f"{'negative':<20} traced / tried")
     for kind, traced, tried in rows:
         print(f"{kind:<20} {traced} / {tried}")

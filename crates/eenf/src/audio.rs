@@ -414,8 +414,11 @@ fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
     ) else {
         bail!("ffmpeg finds no audio stream in it");
     };
-    if fs == 0 || channels == 0 || channels > 64 {
+    if fs == 0 || channels == 0 {
         bail!("ffmpeg finds no audio stream in it");
+    }
+    if channels > 64 {
+        bail!("ffmpeg reports {channels} audio channels: a damaged header (64 at most are read)");
     }
     let mut child = Command::new("ffmpeg")
         .args(["-v", "error", "-nostdin", "-i"])

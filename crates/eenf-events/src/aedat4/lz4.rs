@@ -16,6 +16,17 @@ fn u32_at(b: &[u8], at: usize) -> Option<u32> {
         .map(|s| u32::from_le_bytes(s.try_into().unwrap()))
 }
 
+/// The largest block of a frame, from its BD byte (LZ4 frame format: codes 4-7).
+fn block_max(bd: u8) -> Option<usize> {
+    match (bd >> 4) & 7 {
+        4 => Some(64 << 10),
+        5 => Some(256 << 10),
+        6 => Some(1 << 20),
+        7 => Some(4 << 20),
+        _ => None,
+    }
+}
+
 /// Decodes all LZ4 frames in `input` into `out` (grown as needed, never shrunk) and returns the
 /// number of bytes produced.
 pub(crate) fn decode_frames(input: &[u8], out: &mut Vec<u8>) -> Result<usize, String> {
@@ -45,13 +56,8 @@ pub(crate) fn decode_frames(input: &[u8], out: &mut Vec<u8>) -> Result<usize, St
         let content_size = flg & 0x08 != 0;
         let content_checksum = flg & 0x04 != 0;
         let dict_id = flg & 0x01 != 0;
-        let max_block = match (bd >> 4) & 7 {
-            4 => 64 << 10,
-            5 => 256 << 10,
-            6 => 1 << 20,
-            7 => 4 << 20,
-            v => return Err(format!("bad LZ4 block size code {v}")),
-        };
+        let max_block =
+            block_max(bd).ok_or_else(|| format!("bad LZ4 block size code {}", (bd >> 4) & 7))?;
         pos += 6 + if content_size { 8 } else { 0 } + if dict_id { 4 } else { 0 } + 1;
         let frame_start = n;
         loop {
@@ -120,7 +126,9 @@ pub(crate) fn decoded_bound(input: &[u8]) -> u64 {
             pos = pos.saturating_add(8).saturating_add(len as usize);
             continue;
         }
-        let max_block: u64 = 1 << (8 + 2 * ((bd >> 4) & 7) as u32).min(22);
+        let Some(max_block) = block_max(bd).map(|b| b as u64) else {
+            return MAX_OUTPUT as u64;
+        };
         pos += 6 + if flg & 0x08 != 0 { 8 } else { 0 } + if flg & 0x01 != 0 { 4 } else { 0 } + 1;
         loop {
             let Some(word) = u32_at(input, pos) else {
