@@ -150,6 +150,19 @@ pub fn enf_from_lines(
     p: &EnfParams,
     multiple: f64,
 ) -> Result<EnfEstimates, DspError> {
+    let all: Vec<usize> = (1..=p.harmonics).collect();
+    enf_from_harmonics(x, fs, p, multiple, &all)
+}
+
+/// [`enf_from_lines`] on the lines at `multiple`·m·f_e for each m of `harmonics` (those the
+/// line detector found standing, say), `p.harmonics` aside.
+pub fn enf_from_harmonics(
+    x: &[f64],
+    fs: f64,
+    p: &EnfParams,
+    multiple: f64,
+    harmonics: &[usize],
+) -> Result<EnfEstimates, DspError> {
     let duration_s = x.len() as f64 / fs;
     if duration_s < p.window_s {
         return Err(DspError::TooShort {
@@ -158,9 +171,13 @@ pub fn enf_from_lines(
         });
     }
     let nyquist = fs / 2.0;
-    let bands: Vec<usize> = (1..=p.harmonics)
-        .filter(|m| multiple * *m as f64 * p.nominal_hz + p.half_band_hz < nyquist)
+    let mut bands: Vec<usize> = harmonics
+        .iter()
+        .copied()
+        .filter(|&m| m >= 1 && multiple * m as f64 * p.nominal_hz + p.half_band_hz < nyquist)
         .collect();
+    bands.sort_unstable();
+    bands.dedup();
     if bands.is_empty() {
         return Err(DspError::NoHarmonic {
             nominal_hz: p.nominal_hz,

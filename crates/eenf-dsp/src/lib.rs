@@ -24,6 +24,7 @@ pub mod decimate;
 pub mod enf;
 pub mod filtfilt;
 pub mod flicker;
+pub mod hum;
 pub mod matching;
 pub mod metrics;
 pub mod postprocess;
@@ -34,12 +35,16 @@ pub mod tracker;
 pub use butter::{butter_bandpass, butter_lowpass, sos_to_ba, Section};
 pub use decimate::{decimate, decimation_for, StreamDecimator};
 pub use enf::{
-    check_line, detect_nominal, enf_from_flicker, enf_from_lines, extract_enf, line_prominence,
-    reference_enf, DspError, EnfEstimates, EnfParams, HarmonicEstimates,
+    check_line, detect_nominal, enf_from_flicker, enf_from_harmonics, enf_from_lines, extract_enf,
+    line_prominence, reference_enf, DspError, EnfEstimates, EnfParams, HarmonicEstimates,
 };
 pub use filtfilt::sosfiltfilt;
 pub use flicker::{
     flicker_line, flicker_lines, line_strength_at, FlickerLine, MIN_FLICKER_PROMINENCE,
+};
+pub use hum::{
+    check_holds_line, choose_window, plausibility, search_hum, HumLine, HumSearch, HumVerdict,
+    Plausibility,
 };
 pub use metrics::{agreement, Agreement};
 pub use postprocess::{

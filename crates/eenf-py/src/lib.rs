@@ -432,7 +432,7 @@ fn reference(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<PyTra
         eenf::reference::sound_trace(
             &Sound::File(&path),
             &audio.options(),
-            audio.harmonics as usize,
+            &audio.hum(&tracker),
             tracker.nominal,
             &params,
         )
@@ -466,7 +466,7 @@ fn reference_samples(
         eenf::reference::sound_trace(
             &sound,
             &audio.options(),
-            audio.harmonics as usize,
+            &audio.hum(&tracker),
             tracker.nominal,
             &params,
         )

@@ -105,7 +105,7 @@ def test_trace_files_round_trip(sim, tmp_path):
 
 def test_help_lists_the_parameters_with_their_defaults():
     doc = eenf.extract.__doc__
-    for needle in ["window (default 16)", "sampling (default auto)", "all_pixels", "max_gap"]:
+    for needle in ["step (default 1)", "window", "sampling (default auto)", "all_pixels", "max_gap"]:
         assert needle in doc, needle
     assert "channel (default mix)" in eenf.reference.__doc__
     assert "duration (default 60)" in eenf.simulate.__doc__

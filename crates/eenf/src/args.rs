@@ -69,9 +69,10 @@ pub struct TrackerArgs {
     /// interpolation).
     #[arg(long, default_value = "exact", value_parser = one_of::<PeakMethod>(&PeakMethod::NAMES))]
     pub peak: PeakMethod,
-    /// STFT window length, s.
-    #[arg(long, default_value_t = 16.0, value_parser = number_in(0.01, 3600.0))]
-    pub window: f64,
+    /// STFT window length, s. Default: 16 (the paper's); a recording shorter than that is
+    /// traced with a window that fits it, and `audio` lengthens it for weak hum.
+    #[arg(long, value_parser = number_in(0.01, 3600.0))]
+    pub window: Option<f64>,
     /// STFT step, s (one estimate per step).
     #[arg(long, default_value_t = 1.0, value_parser = number_in(0.001, 3600.0))]
     pub step: f64,
@@ -174,12 +175,13 @@ impl InputArgs {
 impl TrackerArgs {
     /// The tracker part of the parameters.
     pub fn params(&self) -> Result<EnfParams> {
-        if !(self.window > 0.0 && self.step > 0.0 && self.half_band > 0.0) {
+        let window = self.window.unwrap_or(EnfParams::default().window_s);
+        if !(window > 0.0 && self.step > 0.0 && self.half_band > 0.0) {
             bail!("--window, --step and --half-band must be positive");
         }
         Ok(EnfParams {
             peak: self.peak,
-            window_s: self.window,
+            window_s: window,
             step_s: self.step,
             half_band_hz: self.half_band,
             ..EnfParams::default()
@@ -382,14 +384,23 @@ pub struct AudioArgs {
     /// The channel traced: `mix` (the mean of all) or a number from 0.
     #[arg(long, default_value = "mix")]
     pub channel: crate::audio::Channel,
-    /// Mains lines tracked: 1 tracks f0 alone (the method's reference tracker); N tracks f0 …
-    /// N·f0 band by band and takes, per segment, the band the selection rule picks among those
-    /// that stand above their noise (hum is often stronger at 2f0 or 3f0).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=8))]
-    pub harmonics: u32,
+    /// Mains lines tracked: auto (every harmonic of 50 and 60 Hz up to 8·f0 is looked for;
+    /// f0 alone is tracked when it carries the ENF clearly, else every harmonic that stands
+    /// above its noise, band by band, the selection rule picking per segment); 1 tracks f0
+    /// alone (the method's reference tracker); N tracks f0 … N·f0.
+    #[arg(long, default_value = "auto")]
+    pub harmonics: crate::reference::MainsLines,
 }
 
 impl AudioArgs {
+    /// How the hum is traced: these lines, and the tracker's `--window` if one was given.
+    pub fn hum(&self, tracker: &TrackerArgs) -> crate::reference::HumOptions {
+        crate::reference::HumOptions {
+            lines: self.harmonics,
+            window_s: tracker.window,
+        }
+    }
+
     /// The reading options (the rate follows from the harmonics tracked).
     pub fn options(&self) -> crate::audio::AudioOptions {
         crate::audio::AudioOptions {

@@ -123,6 +123,31 @@ impl Sink {
     }
 }
 
+impl Audio {
+    /// The signal brought down further, to the lowest rate that keeps every band up to
+    /// `top_hz` (the same streaming FIR decimation, its delay taken back out); unchanged when
+    /// no lower rate does.
+    pub fn narrowed(&self, top_hz: f64) -> Signal {
+        let mut d = StreamDecimator::new(self.signal.fs, top_hz);
+        if d.factor() <= 1 {
+            return self.signal.clone();
+        }
+        let mut samples = Vec::with_capacity(self.signal.samples.len() / d.factor() + 1);
+        d.push(&self.signal.samples, &mut samples);
+        let lag = (d.delay_s() * d.fs_out()).round() as usize;
+        // the tail the delay held back: flush it with zeros, then drop the delay in front
+        let tail = lag * d.factor() + d.factor();
+        d.push(&vec![0.0; tail], &mut samples);
+        let want = self.signal.samples.len().div_ceil(d.factor());
+        samples.drain(..lag.min(samples.len()));
+        samples.truncate(want);
+        Signal {
+            fs: d.fs_out(),
+            samples,
+        }
+    }
+}
+
 /// Reads the sound of `path` as `opts` says: Symphonia first, then ffmpeg for what it cannot
 /// read (video containers, other codecs). A damaged packet is skipped; a recording with no
 /// sound is an error.

@@ -6,7 +6,9 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use eenf_dsp::{EnfEstimates, EnfParams, FlickerLine, PeakMethod, SamplingMethod};
+use eenf_dsp::{
+    EnfEstimates, EnfParams, FlickerLine, HumSearch, PeakMethod, Plausibility, SamplingMethod,
+};
 use eenf_video::{RowSampling, SceneRemoval, VideoAnalysis, VideoOptions};
 use serde::{Deserialize, Serialize};
 
@@ -127,6 +129,24 @@ pub struct MainsProvenance {
     /// How the sound was read, when it was (decoder, rates, channel).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub audio: Option<AudioProvenance>,
+    /// What the line detector found and what was made of it (`audio --harmonics auto`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hum: Option<HumReport>,
+}
+
+/// The hum of a recording as the line detector saw it, the lines traced, the window chosen,
+/// and how the trace compares with what grids do.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HumReport {
+    /// Every harmonic's line in the Welch spectrum (both grids unless one was named).
+    pub search: HumSearch,
+    /// The harmonics tracked (those of the grid that stand), strongest first.
+    pub carriers: Vec<usize>,
+    /// Why the window differs from the default, when it does.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub window_note: Option<String>,
+    /// Offset from nominal, spread, and the flags they raise.
+    pub plausibility: Plausibility,
 }
 
 fn one() -> usize {
@@ -310,6 +330,7 @@ impl Trace {
                 window_s: params.window_s,
                 mains_lines: 1,
                 audio: None,
+                hum: None,
             })),
             ..Trace::new(params.step_s, enf_hz)
         }

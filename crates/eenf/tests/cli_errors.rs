@@ -117,7 +117,7 @@ fn bad_inputs_give_one_line_errors() {
         &["reference", "--nominal", "50", "noise.wav"],
         d,
         "noise.wav",
-        "no 50 Hz mains line",
+        "no mains line at any harmonic of 50 Hz",
     );
     eenf::wav::write_wav(&d.join("slow.wav"), 80, &noise[..2400]).unwrap();
     fails(&["reference", "slow.wav"], d, "slow.wav", "too low");

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use eenf::audio::{AudioOptions, Channel, Sound};
 use eenf::extract::{extract, ExtractOptions, Recording};
 use eenf::progress::Progress;
-use eenf::reference::sound_trace;
+use eenf::reference::{sound_trace, HumOptions, MainsLines};
 use eenf_events::EventBatch;
 
 fn same(a: &[f64], b: &[f64]) -> bool {
@@ -70,7 +70,11 @@ fn samples_in_memory_give_the_wav_trace_and_nan_is_refused() {
         eenf_dsp::EnfParams::default(),
     );
     let nominal = eenf::extract::Nominal::Auto;
-    let want = sound_trace(&Sound::File(&wav), &audio, 1, nominal, &params).unwrap();
+    let one = HumOptions {
+        lines: MainsLines::UpTo(1),
+        window_s: None,
+    };
+    let want = sound_trace(&Sound::File(&wav), &audio, &one, nominal, &params).unwrap();
     let in_memory = |pcm: &[f32]| {
         let sound = Sound::Samples {
             name: Path::new("pcm"),
@@ -78,7 +82,7 @@ fn samples_in_memory_give_the_wav_trace_and_nan_is_refused() {
             channels: 1,
             fs: fs as f64,
         };
-        sound_trace(&sound, &audio, 1, nominal, &params)
+        sound_trace(&sound, &audio, &one, nominal, &params)
     };
     let got = in_memory(&pcm).unwrap();
     assert!(same(&got.enf_hz, &want.enf_hz));

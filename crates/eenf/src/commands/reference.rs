@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use eenf::progress::Progress;
 use eenf::reference::audio_trace;
+use eenf::trace::{MainsProvenance, Provenance};
 
 use eenf::args::{AudioArgs, TraceOutputArgs, TrackerArgs};
 
@@ -29,7 +30,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let trace = audio_trace(
         &a.wav,
         &a.audio.options(),
-        a.audio.harmonics as usize,
+        &a.audio.hum(&a.tracker),
         a.tracker.nominal,
         &params,
     )?;
@@ -48,6 +49,32 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         params.peak,
         started.elapsed().as_secs_f64()
     );
+    if let Some(Provenance::Mains(MainsProvenance { hum: Some(h), .. })) = &trace.provenance {
+        let grid = trace.nominal_hz.unwrap_or(f64::NAN);
+        let lines: Vec<String> = h
+            .carriers
+            .iter()
+            .filter_map(|k| {
+                h.search
+                    .of_grid(grid)
+                    .find(|l| l.harmonic == *k)
+                    .map(|l| format!("{k} x f0 {:.1} dB", l.db))
+            })
+            .collect();
+        eprintln!(
+            "hum lines traced (over their local floor, {:.1} dB needed, {:.0} s segments x {}): {}",
+            h.search.lines.first().map_or(f64::NAN, |l| l.threshold_db),
+            h.search.segment_s,
+            h.search.segments,
+            lines.join(", ")
+        );
+        if let Some(note) = &h.window_note {
+            eprintln!("note: {note}");
+        }
+        for flag in &h.plausibility.flags {
+            eprintln!("warning: {}: {flag}", a.wav.display());
+        }
+    }
     if let Some(&last) = trace.selected.last() {
         let mut taken: Vec<usize> = trace.selected.iter().map(|s| s.harmonic).collect();
         taken.dedup();
