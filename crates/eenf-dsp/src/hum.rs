@@ -71,6 +71,9 @@ pub struct HumSearch {
     pub segment_s: f64,
     /// Segments averaged.
     pub segments: usize,
+    /// The height noise alone reaches with probability [`FALSE_ALARM`] over every bin
+    /// searched, dB over the floor (each line's threshold is this or [`MIN_LINE_DB`]).
+    pub noise_db: f64,
     /// 1 for sound (lines at k·f0), 2 for light flicker (k·2f0).
     pub multiple: f64,
     /// The lines, grid by grid, harmonic by harmonic.
@@ -176,6 +179,7 @@ pub fn search_hum(
     Some(HumSearch {
         segment_s: seg as f64 / fs,
         segments: starts.len(),
+        noise_db: threshold_db,
         multiple,
         lines: found,
     })
@@ -212,9 +216,11 @@ impl HumSearch {
                 .copied()
                 .filter(|l| {
                     (l.f0_hz - grid).abs() <= USUAL_OFFSET_HZ
-                        || standing
-                            .iter()
-                            .any(|o| o.harmonic != l.harmonic && self.agree(o, l))
+                        || standing.iter().any(|o| {
+                            o.harmonic != l.harmonic
+                                && o.db >= o.threshold_db + CONFIRM_MARGIN_DB
+                                && self.agree(o, l)
+                        })
                 })
                 .collect();
             let Some(top) = believed
@@ -231,6 +237,10 @@ impl HumSearch {
                 .filter(|l| self.agree(l, top))
                 .collect();
             carriers.sort_by(|a, b| b.db.total_cmp(&a.db));
+            // a line that no other harmonic confirms must clear the noise by a margin
+            if carriers.len() == 1 && top.db < self.noise_db + CONFIRM_MARGIN_DB {
+                continue;
+            }
             if best.as_ref().is_none_or(|b| top.db > b.strongest.db) {
                 best = Some(HumVerdict {
                     grid_hz: grid,
@@ -273,6 +283,12 @@ impl HumSearch {
             );
         }
         match self.strongest() {
+            Some(l) if l.stands() && (l.f0_hz - l.grid_hz).abs() <= USUAL_OFFSET_HZ => format!(
+                "no mains line: the strongest, {}, stands {:.1} dB above its local floor, but no other harmonic confirms it and a line alone must clear {:.1} dB",
+                name(l),
+                l.db,
+                self.noise_db + CONFIRM_MARGIN_DB
+            ),
             Some(l) if l.stands() => format!(
                 "no mains line: the only line that stands, {} ({:.3} Hz), lies {:.0} mHz from its grid at that one harmonic alone (a tone, not the mains)",
                 name(l),
@@ -293,6 +309,13 @@ impl HumSearch {
 
 /// How closely a Welch peak is placed, in bins, for two harmonics to confirm each other.
 const CONFIRM_BINS: f64 = 0.3;
+
+/// A line confirms another far from nominal only when it clears its threshold by this much,
+/// dB, and a line that no other harmonic confirms must clear the noise's height by as much: a
+/// marginal peak lands within the tolerance by chance (a 7 Hz square wave's 399 Hz line, 125
+/// mHz below 8·50 Hz, was "confirmed" by noise 9.8 dB high at 3 f0, threshold 8.8 dB), and a
+/// 44.1 kHz square wave holds weak steady lines (9–10 dB at 480.3 Hz) that no grid made.
+const CONFIRM_MARGIN_DB: f64 = 3.0;
 
 /// The average power spectrum of Hann-windowed segments of `x` of `seg` samples starting at
 /// `starts` (zero-padded to a power of two), computed on every core.
@@ -605,7 +628,12 @@ mod tests {
     #[test]
     fn a_hum_at_four_f0_alone_is_found_and_its_grid_told() {
         let fs = 1000.0;
+        // a lone line just over the noise's height (7.9 dB, noise reaches 6.6) is not enough
         let x = with_tone(&noise(3, 60_000), fs, 4.0 * 50.013, 0.05);
+        let s = search_hum(&x, fs, 1.0, &[50.0, 60.0], MAX_HUM_HARMONIC).unwrap();
+        let e = s.verdict().unwrap_err().to_string();
+        assert!(e.contains("no other harmonic confirms"), "{e}");
+        let x = with_tone(&noise(3, 60_000), fs, 4.0 * 50.013, 0.08);
         let s = search_hum(&x, fs, 1.0, &[50.0, 60.0], MAX_HUM_HARMONIC).unwrap();
         let v = s.verdict().unwrap();
         assert_eq!(v.grid_hz, 50.0);
