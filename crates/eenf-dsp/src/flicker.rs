@@ -148,20 +148,7 @@ pub fn flicker_lines(x: &[f64], fs: f64) -> Option<[FlickerLine; 2]> {
 mod tests {
     use super::*;
 
-    /// Close to Gaussian noise of unit variance (a sum of twelve uniforms), from `seed`.
-    fn noise(mut seed: u64) -> impl FnMut() -> f64 {
-        move || {
-            (0..12)
-                .map(|_| {
-                    seed ^= seed << 13;
-                    seed ^= seed >> 7;
-                    seed ^= seed << 17;
-                    (seed >> 11) as f64 / (1u64 << 53) as f64
-                })
-                .sum::<f64>()
-                - 6.0
-        }
-    }
+    use crate::test_noise as noise;
 
     /// A tone in noise: the line is found to a few mHz and its prominence grows with its
     /// amplitude; noise alone stays below the threshold.

@@ -590,21 +590,10 @@ const WINDOW_LINE_DB: f64 = 13.0;
 mod tests {
     use super::*;
 
-    /// Close to Gaussian noise of unit variance, from `seed`.
-    fn noise(mut seed: u64, n: usize) -> Vec<f64> {
-        (0..n)
-            .map(|_| {
-                (0..12)
-                    .map(|_| {
-                        seed ^= seed << 13;
-                        seed ^= seed >> 7;
-                        seed ^= seed << 17;
-                        (seed >> 11) as f64 / (1u64 << 53) as f64
-                    })
-                    .sum::<f64>()
-                    - 6.0
-            })
-            .collect()
+    /// `n` samples of the unit tests' noise from `seed`.
+    fn noise(seed: u64, n: usize) -> Vec<f64> {
+        let mut g = crate::test_noise(seed);
+        (0..n).map(|_| g()).collect()
     }
 
     fn with_tone(x: &[f64], fs: f64, f: f64, a: f64) -> Vec<f64> {
