@@ -244,7 +244,6 @@ pub fn sound_trace(
     check_holds_line(&trace.enf_hz, p.step_s, window_s).map_err(err)?;
     let plausibility = plausibility(&trace.enf_hz, p.step_s, f0, edge);
     if let Some(Provenance::Mains(m)) = trace.provenance.as_mut() {
-        m.mains_lines = carriers.len();
         m.audio = Some(provenance_audio(sig.fs));
         m.hum = Some(HumReport {
             search,
