@@ -4,6 +4,7 @@ use rayon::prelude::*;
 use realfft::RealFftPlanner;
 
 use crate::butter::butter_bandpass;
+use crate::chirp::follow_chirps;
 use crate::filtfilt::sosfiltfilt;
 use crate::postprocess::{median_correct, select_audible_harmonics, HarmonicSelection};
 use crate::sampling::{PolaritySequence, SamplingError};
@@ -163,6 +164,57 @@ pub fn enf_from_harmonics(
     multiple: f64,
     harmonics: &[usize],
 ) -> Result<EnfEstimates, DspError> {
+    harmonics_enf(x, fs, p, multiple, harmonics, false)
+}
+
+/// [`enf_from_harmonics`] for hum in sound (`multiple` 1), each band's estimates followed
+/// through the window's sweep ([`follow_chirps`]) when the peak is the exact one: weak hum at
+/// k·f0 sweeps k times as fast as the ENF, and its line then spreads over several bins. Only
+/// bands whose line a fast swing moves by two bins or more within a window are followed (4 f0
+/// in the 32 s windows weak hum gets, say), and only in recordings of
+/// [`FOLLOW_MIN_WINDOWS`] windows or more.
+pub fn enf_from_hum_lines(
+    x: &[f64],
+    fs: f64,
+    p: &EnfParams,
+    harmonics: &[usize],
+) -> Result<EnfEstimates, DspError> {
+    // the sweep rate is fitted to the neighbours within half a window: a clip of fewer than
+    // three windows has too few of them on both sides for most of its estimates
+    let long_enough = x.len() as f64 / fs >= FOLLOW_MIN_WINDOWS * p.window_s;
+    harmonics_enf(
+        x,
+        fs,
+        p,
+        1.0,
+        harmonics,
+        p.peak == PeakMethod::Exact && long_enough,
+    )
+}
+
+/// How far from the least-squares line through its neighbours a followed estimate may move,
+/// on the f0 scale, Hz: the grids' largest swing within one window stays under it.
+const FOLLOW_REACH_HZ: f64 = 0.025;
+
+/// Recordings of fewer windows than this are tracked without following the sweep.
+pub const FOLLOW_MIN_WINDOWS: f64 = 3.0;
+
+/// A real grid's swing at its fast moments, Hz/s (the Wuhan mains hours' one-second mean
+/// frequencies step by 2.5 mHz std).
+const FAST_SWING_HZ_PER_S: f64 = 0.001;
+
+/// A band is followed when such a swing moves its line this many bins within a window: 4 f0
+/// in 32 s windows (4.1 bins), not 4 f0 in 16 s ones (1.0), where following gains nothing.
+const FOLLOW_MIN_SWEEP_BINS: f64 = 2.0;
+
+fn harmonics_enf(
+    x: &[f64],
+    fs: f64,
+    p: &EnfParams,
+    multiple: f64,
+    harmonics: &[usize],
+    follow: bool,
+) -> Result<EnfEstimates, DspError> {
     let duration_s = x.len() as f64 / fs;
     if duration_s < p.window_s {
         return Err(DspError::TooShort {
@@ -195,11 +247,24 @@ pub fn enf_from_harmonics(
             let tracked = tracker.track_with_snr(&y, band);
             // correct outliers on the first line's scale, report on the f_e scale
             let on_first: Vec<f64> = tracked.iter().map(|(f, _)| f / m as f64).collect();
-            let corrected = if p.median_len > 1 {
+            let mut corrected = if p.median_len > 1 {
                 median_correct(&on_first, p.median_len, p.median_threshold_hz)
             } else {
                 on_first
             };
+            // bins a fast swing of the grid moves this band's line within one window
+            let sweep_bins = multiple * m as f64 * FAST_SWING_HZ_PER_S * p.window_s.powi(2);
+            if follow && sweep_bins >= FOLLOW_MIN_SWEEP_BINS {
+                // twice: the first pass's steps bend the sweep rates the second one uses
+                let m = m as f64;
+                let reach = FOLLOW_REACH_HZ * m;
+                for _ in 0..2 {
+                    let line: Vec<f64> = corrected.iter().map(|f| f * m).collect();
+                    let followed =
+                        follow_chirps(&y, fs, center, &line, p.window_s, p.step_s, reach);
+                    corrected = followed.iter().map(|f| f / m).collect();
+                }
+            }
             HarmonicEstimates {
                 harmonic: m,
                 center_hz: center,

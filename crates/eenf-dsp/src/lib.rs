@@ -20,6 +20,7 @@
 #![forbid(unsafe_code)]
 
 pub mod butter;
+pub mod chirp;
 pub mod decimate;
 pub mod enf;
 pub mod filtfilt;
@@ -33,10 +34,12 @@ pub mod spectrogram;
 pub mod tracker;
 
 pub use butter::{butter_bandpass, butter_lowpass, sos_to_ba, Section};
+pub use chirp::follow_chirps;
 pub use decimate::{decimate, decimation_for, StreamDecimator};
 pub use enf::{
-    check_line, detect_nominal, enf_from_flicker, enf_from_harmonics, enf_from_lines, extract_enf,
-    line_prominence, reference_enf, DspError, EnfEstimates, EnfParams, HarmonicEstimates,
+    check_line, detect_nominal, enf_from_flicker, enf_from_harmonics, enf_from_hum_lines,
+    enf_from_lines, extract_enf, line_prominence, reference_enf, DspError, EnfEstimates, EnfParams,
+    HarmonicEstimates,
 };
 pub use filtfilt::sosfiltfilt;
 pub use flicker::{

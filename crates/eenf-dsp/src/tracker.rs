@@ -295,27 +295,36 @@ fn dtft_peak(seg: &[f64], fs: f64, f0: f64, bracket: (f64, f64)) -> (f64, f64) {
         }
     }
     // golden-section search on the bracket
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut a, mut b) = bracket;
-    let mut c = b - g * (b - a);
-    let mut d = a + g * (b - a);
-    let (mut pc, mut pd) = (dtft_power(seg, fs, c), dtft_power(seg, fs, d));
-    while b - a > 1e-8 {
-        if pc > pd {
+    golden_section_max(|f| dtft_power(seg, fs, f), bracket, 1e-8)
+}
+
+/// The point of (a, b) where the unimodal `g` peaks, to within `tol`, and `g` there:
+/// golden-section search.
+pub(crate) fn golden_section_max(
+    g: impl Fn(f64) -> f64,
+    (mut a, mut b): (f64, f64),
+    tol: f64,
+) -> (f64, f64) {
+    let ratio = (5f64.sqrt() - 1.0) / 2.0;
+    let mut c = b - ratio * (b - a);
+    let mut d = a + ratio * (b - a);
+    let (mut gc, mut gd) = (g(c), g(d));
+    while b - a > tol {
+        if gc > gd {
             b = d;
             d = c;
-            pd = pc;
-            c = b - g * (b - a);
-            pc = dtft_power(seg, fs, c);
+            gd = gc;
+            c = b - ratio * (b - a);
+            gc = g(c);
         } else {
             a = c;
             c = d;
-            pc = pd;
-            d = a + g * (b - a);
-            pd = dtft_power(seg, fs, d);
+            gc = gd;
+            d = a + ratio * (b - a);
+            gd = g(d);
         }
     }
-    ((a + b) / 2.0, pc.max(pd))
+    ((a + b) / 2.0, gc.max(gd))
 }
 
 #[cfg(test)]

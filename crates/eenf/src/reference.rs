@@ -10,7 +10,7 @@ use eenf_dsp::matching::{
     Verification,
 };
 use eenf_dsp::{
-    check_holds_line, choose_window, enf_from_harmonics, plausibility, reference_enf, search_hum,
+    check_holds_line, choose_window, enf_from_hum_lines, plausibility, reference_enf, search_hum,
     EnfParams,
 };
 
@@ -226,8 +226,7 @@ pub fn sound_trace(
         let enf = reference_enf(&sig.samples, sig.fs, &p).map_err(err)?;
         Trace::from_mains(path, f0, &p, enf)
     } else {
-        let estimates =
-            enf_from_harmonics(&sig.samples, sig.fs, &p, 1.0, &carriers).map_err(err)?;
+        let estimates = enf_from_hum_lines(&sig.samples, sig.fs, &p, &carriers).map_err(err)?;
         Trace::from_mains_lines(
             path,
             f0,

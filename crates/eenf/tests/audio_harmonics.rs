@@ -85,21 +85,47 @@ fn mae_against_truth(t: &Trace, clean: &[f32], fs: f64) -> f64 {
     pairs.iter().sum::<f64>() / pairs.len() as f64
 }
 
-/// Weak hum (10 dB in a 16 s window, 7 dB in the detector's Welch spectrum: the ENF's jitter
-/// spreads the line fourfold at 4 f0) is found, and traced with a 32 s window. Its error is
-/// what the window's line strength allows: the Cramér-Rao bound of a 16 s window at this
-/// strength is 1.9 mHz on the f0 scale, of a 32 s window 0.7 mHz.
+/// The real grid's fine structure: the simulator's per-second jitter (11 mHz, fitted to the
+/// references as 16 s windows see them) makes one-second mean frequencies step by 16 mHz, six
+/// times what the Wuhan mains recordings show at their own phase (std 2.5 mHz, measured with
+/// the analytic signal of the 400 Hz WAVs; that includes their noise). At 4 f0 the difference
+/// matters: the line spreads with it.
+fn real_grid() -> SyntheticEnf {
+    SyntheticEnf {
+        jitter_std_hz: 0.0017,
+        ..SyntheticEnf::default()
+    }
+}
+
+/// Weak hum (10 dB in a 16 s window; 4.5–7 dB in the detector's Welch spectrum, as the ENF's
+/// swings spread the line at 4 f0) is found in most realisations and traced with a 32 s
+/// window, each window dechirped by the sweep its neighbours show: MAE under 1 mHz against the
+/// truth. (The Cramér-Rao bound of one 16 s window at this strength is 1.9 mHz on the f0
+/// scale, of a 32 s window 0.7 mHz.) Undechirped, such traces err by 1.7 mHz in the median.
 #[test]
-fn weak_hum_at_four_f0_alone_is_found_and_traced_with_a_longer_window_at_1_and_8_khz() {
-    for (fs, seed) in [(1000.0, 1u64), (8000.0, 2)] {
-        let phase = MainsPhase::synthetic(50.0, 240.0, SyntheticEnf::default(), seed);
-        let (noisy, clean) = hum(&phase, fs, 4.0, 10.0, seed);
-        let t = trace(&noisy, fs, HumOptions::default()).unwrap();
-        let (window, carriers) = how(&t);
-        assert_eq!(t.nominal_hz, Some(50.0));
-        assert_eq!((window, carriers), (32.0, vec![4]), "{fs} Hz");
-        let mae = mae_against_truth(&t, &clean, fs);
-        assert!(mae <= 3e-3, "{fs} Hz: MAE {:.2} mHz", mae * 1e3);
+fn weak_hum_at_four_f0_alone_is_found_and_traced_within_a_millihertz_at_1_and_8_khz() {
+    for fs in [1000.0, 8000.0] {
+        let mut traced = 0;
+        for seed in 1..=6u64 {
+            let phase = MainsPhase::synthetic(50.0, 240.0, real_grid(), seed);
+            let (noisy, clean) = hum(&phase, fs, 4.0, 10.0, seed);
+            // too weak to tell from noise at a false-alarm rate of 1e-3 now and then: the
+            // line then stands under 6 dB in the detector's spectrum
+            let Ok(t) = trace(&noisy, fs, HumOptions::default()) else {
+                continue;
+            };
+            traced += 1;
+            assert_eq!(t.nominal_hz, Some(50.0));
+            assert_eq!(how(&t), (32.0, vec![4]), "{fs} Hz, seed {seed}");
+            let mae = mae_against_truth(&t, &clean, fs);
+            eprintln!("{fs} Hz, seed {seed}: MAE {:.2} mHz", mae * 1e3);
+            assert!(
+                mae <= 1e-3,
+                "{fs} Hz, seed {seed}: MAE {:.2} mHz",
+                mae * 1e3
+            );
+        }
+        assert!(traced >= 5, "{fs} Hz: {traced} of 6 traced");
     }
 }
 
@@ -113,6 +139,7 @@ fn hum_at_three_or_five_f0_is_traced_at_44_1_khz() {
         assert_eq!(t.nominal_hz, Some(grid));
         assert_eq!(how(&t), (16.0, vec![k as usize]));
         let mae = mae_against_truth(&t, &clean, 44_100.0);
+        eprintln!("{k} f0: MAE {:.2} mHz", mae * 1e3);
         assert!(mae <= 1e-3, "{k} f0: MAE {:.2} mHz", mae * 1e3);
     }
 }
