@@ -2,7 +2,7 @@
 //! polarity sequence E(n) ∈ {−1, 0, +1} (majority vote of the polarities in each sample), or
 //! the signed count ON − OFF of every event in each bin for sensors that stamp events one by one.
 
-use eenf_events::EventBatch;
+use eenf_core::EventBatch;
 
 /// How events are chosen for sample n (t_n = t_1 + n·Δt). See `docs/method.md`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

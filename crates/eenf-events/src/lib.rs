@@ -21,7 +21,6 @@
 #![deny(unsafe_code)]
 
 pub mod aedat4;
-mod batch;
 pub mod contain;
 mod error;
 mod guard;
@@ -37,8 +36,8 @@ use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
 pub use aedat4::{Aedat4Reader, Aedat4Writer, Compression};
-pub use batch::EventBatch;
 pub use contain::contain;
+pub use eenf_core::EventBatch;
 pub use error::{EventError, Result};
 pub use guard::{Damage, DamageKind, DEFAULT_MAX_GAP_US};
 pub use memory::open_events;

@@ -1,0 +1,11 @@
+//! # eenf-core
+//!
+//! The words the other eenf crates share, defined once and free of I/O: the batch of events
+//! that readers produce and the temporal sampler consumes. It depends on nothing, so that the
+//! signal processing needs no file format to compile.
+
+#![forbid(unsafe_code)]
+
+pub mod batch;
+
+pub use batch::EventBatch;
