@@ -1,11 +1,14 @@
 //! # eenf-core
 //!
 //! The words the other eenf crates share, defined once and free of I/O: the batch of events
-//! that readers produce and the temporal sampler consumes. It depends on nothing, so that the
+//! that readers produce and the temporal sampler consumes, and the grid a recording was made
+//! on (given or detected). It depends on nothing, so that the
 //! signal processing needs no file format to compile.
 
 #![forbid(unsafe_code)]
 
 pub mod batch;
+pub mod grid;
 
 pub use batch::EventBatch;
+pub use grid::Nominal;

@@ -18,9 +18,10 @@ use eenf::args::{
     VideoMethodArgs,
 };
 use eenf::audio::Sound;
-use eenf::extract::{Nominal, Recording};
+use eenf::extract::Recording;
 use eenf::progress::Progress;
 use eenf::trace::Trace;
+use eenf_core::Nominal;
 use eenf_events::{EventBatch, EventReader};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyStopIteration, PyValueError};

@@ -8,8 +8,9 @@
 use std::path::PathBuf;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use eenf::extract::{extract_file, ExtractOptions, Nominal};
+use eenf::extract::{extract_file, ExtractOptions};
 use eenf::progress::Progress;
+use eenf_core::Nominal;
 use eenf_events::writers::{create, OutputFormat};
 use eenf_events::{Compression, EventBatch};
 

@@ -5,10 +5,11 @@
 use std::path::PathBuf;
 use std::str::FromStr;
 
-use crate::extract::{ExtractOptions, Nominal};
+use crate::extract::ExtractOptions;
 use crate::simulation::{EnfSource, Recipe};
 use anyhow::{bail, Context, Result};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
+use eenf_core::Nominal;
 use eenf_dsp::{EnfParams, HarmonicSelection, PeakMethod, SamplingMethod};
 use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;

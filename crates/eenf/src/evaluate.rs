@@ -8,12 +8,12 @@ use anyhow::{bail, Context, Result};
 use eenf_dsp::{agreement, Agreement, EnfParams};
 
 use crate::dataset::{recording_start, reference_hour};
-use crate::extract::Nominal;
 use crate::output::folder_of;
 use crate::reference::{reference_file, reference_for_recording};
 use crate::time::LocalTime;
 use crate::trace::Trace;
 use crate::wav::is_wav;
+use eenf_core::Nominal;
 
 /// Where a recording's reference ENF comes from.
 #[derive(Debug, Clone, PartialEq)]

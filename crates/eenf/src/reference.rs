@@ -16,12 +16,12 @@ use eenf_dsp::{
 
 use crate::audio::{AudioOptions, Sound};
 use crate::dataset::hourly_references;
-use crate::extract::Nominal;
 use crate::progress::Progress;
 use crate::refdb::{RefSeries, GAP};
 use crate::time::LocalTime;
 use crate::trace::{AudioProvenance, HumReport, MainsProvenance, Provenance, Trace};
 use crate::wav::{read_wav, Signal};
+use eenf_core::Nominal;
 
 /// Decides or checks the nominal frequency of a mains signal: the line detector on f0 alone.
 pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<f64> {

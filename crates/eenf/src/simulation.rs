@@ -9,13 +9,13 @@ use eenf_events::writers::OutputFormat;
 use eenf_sim::{simulate, CameraConfig, MainsPhase, SimConfig, SimStats, SyntheticEnf};
 
 use crate::dataset::{hourly_references, reference_name};
-use crate::extract::Nominal;
 use crate::output::{sibling, write_atomic, write_events};
 use crate::progress::Progress;
 use crate::reference::mains_nominal;
 use crate::time::{offset_of, parse_time, LocalTime};
 use crate::trace::Trace;
 use crate::wav::{is_wav, read_wav, write_wav};
+use eenf_core::Nominal;
 
 /// Sampling rate of synthesized mains references (the dataset's).
 pub const REFERENCE_FS: u32 = 400;

@@ -6,9 +6,9 @@
 use std::path::Path;
 
 use eenf::audio::{AudioOptions, Sound};
-use eenf::extract::Nominal;
 use eenf::reference::{sound_trace, HumOptions, MainsLines};
 use eenf::trace::{Provenance, Trace};
+use eenf_core::Nominal;
 use eenf_dsp::EnfParams;
 use eenf_sim::{MainsPhase, SyntheticEnf};
 use rand::{Rng, SeedableRng};

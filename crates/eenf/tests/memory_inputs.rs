@@ -69,7 +69,7 @@ fn samples_in_memory_give_the_wav_trace_and_nan_is_refused() {
         },
         eenf_dsp::EnfParams::default(),
     );
-    let nominal = eenf::extract::Nominal::Auto;
+    let nominal = eenf_core::Nominal::Auto;
     let one = HumOptions {
         lines: MainsLines::UpTo(1),
         window_s: None,

@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
-use eenf::extract::Nominal;
 use eenf::reference::reference_file;
+use eenf_core::Nominal;
 use eenf_dsp::matching::{match_trace, MatchOptions, DEFAULT_ALPHA};
 use eenf_dsp::EnfParams;
 

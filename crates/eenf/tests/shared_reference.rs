@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
-use eenf::extract::Nominal;
 use eenf::reference::reference_file;
+use eenf_core::Nominal;
 use eenf_dsp::{EnfParams, PeakMethod};
 
 mod common;

@@ -7,9 +7,10 @@ use serde::Serialize;
 
 use super::{class_rank, Method, Recording, Settings};
 use crate::evaluate::{compare, Comparison, Reference};
-use crate::extract::{extract_sampled, sample_file, Nominal};
+use crate::extract::{extract_sampled, sample_file};
 use crate::progress::Progress;
 use crate::trace::Trace;
+use eenf_core::Nominal;
 
 /// What a method gave on a recording, kept for plots and trace files.
 #[derive(Debug, Clone)]

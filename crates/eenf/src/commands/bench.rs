@@ -8,9 +8,9 @@ use eenf::bench::report::{
 };
 use eenf::bench::run::{jobs_for, run_all};
 use eenf::bench::{discover, group_by_prominence, sweep, Method, Settings};
-use eenf::extract::Nominal;
 use eenf::output::write_atomic;
 use eenf::progress::Progress;
+use eenf_core::Nominal;
 use eenf_video::{IdleRows, RowSampling, SceneRemoval, VideoOptions};
 
 use eenf::args::{one_of, MethodArgs};

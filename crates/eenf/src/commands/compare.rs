@@ -4,10 +4,10 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use eenf::evaluate::compare_trace;
-use eenf::extract::Nominal;
 use eenf::plot::plot_comparison;
 use eenf::progress::Progress;
 use eenf::trace::Trace;
+use eenf_core::Nominal;
 use eenf_dsp::{EnfParams, PeakMethod};
 
 use eenf::args::one_of;

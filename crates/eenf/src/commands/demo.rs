@@ -4,12 +4,13 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use eenf::evaluate::compare_trace;
-use eenf::extract::{extract_file, ExtractOptions, Nominal};
+use eenf::extract::{extract_file, ExtractOptions};
 use eenf::output::{sibling, write_atomic};
 use eenf::plot::{plot_comparison, plot_extraction};
 use eenf::progress::Progress;
 use eenf::simulation::{simulate_recording, Recipe};
 use eenf::trace::Trace;
+use eenf_core::Nominal;
 use eenf_dsp::EnfParams;
 use eenf_sim::{SceneKind, SimConfig};
 

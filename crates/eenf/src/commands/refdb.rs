@@ -3,13 +3,13 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use eenf::extract::Nominal;
 use eenf::progress::Progress;
 use eenf::refdb::{check_grid_name, RefSeries, StoreLock, GAP};
 use eenf::reference::{reference_file, wav_start};
 use eenf::time::{parse_time, tz_offset, utc};
 use eenf::trace::Trace;
 use eenf::wav::is_wav;
+use eenf_core::Nominal;
 use eenf_dsp::EnfParams;
 
 /// `eenf refdb` subcommands.
