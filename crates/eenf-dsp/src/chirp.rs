@@ -28,6 +28,9 @@ const BASEBAND_HZ: f64 = 32.0;
 /// starting point are the least-squares line through the estimates within half a window, and
 /// the peak is sought within `reach_hz` of that line's value at the window's centre.
 /// Estimates without three finite neighbours in reach are kept as they are.
+/// This is done `passes` times, each pass fitting the sweeps to the last one's estimates (the
+/// line in baseband is made once).
+#[allow(clippy::too_many_arguments)]
 pub fn follow_chirps(
     y: &[f64],
     fs: f64,
@@ -36,9 +39,31 @@ pub fn follow_chirps(
     window_s: f64,
     step_s: f64,
     reach_hz: f64,
+    passes: usize,
 ) -> Vec<f64> {
     let q = ((fs / BASEBAND_HZ).floor() as usize).max(1);
     let base = baseband(y, fs, center_hz, q);
+    let mut estimates = line_hz.to_vec();
+    for _ in 0..passes {
+        estimates = follow_once(
+            &base, q, fs, center_hz, &estimates, window_s, step_s, reach_hz,
+        );
+    }
+    estimates
+}
+
+/// One pass of [`follow_chirps`] over the baseband `base` (blocks of `q` samples).
+#[allow(clippy::too_many_arguments)]
+fn follow_once(
+    base: &[Complex64],
+    q: usize,
+    fs: f64,
+    center_hz: f64,
+    line_hz: &[f64],
+    window_s: f64,
+    step_s: f64,
+    reach_hz: f64,
+) -> Vec<f64> {
     let dt = q as f64 / fs;
     // the centroid time of block j
     let t0 = (q as f64 - 1.0) / 2.0 / fs;
@@ -185,7 +210,7 @@ mod tests {
             .enumerate()
             .map(|(i, f)| f + if i % 7 == 0 { 0.03 } else { 0.0 })
             .collect();
-        let followed = follow_chirps(&y, fs, 200.0, &first, 32.0, 1.0, 0.1);
+        let followed = follow_chirps(&y, fs, 200.0, &first, 32.0, 1.0, 0.1, 1);
         for i in 16..=104 {
             assert!(
                 (followed[i] - truth[i]).abs() < 2e-4,
@@ -200,7 +225,7 @@ mod tests {
     fn estimates_without_neighbours_are_kept() {
         let y = vec![0.0; 10_000];
         let first = vec![f64::NAN, 200.0, f64::NAN, f64::NAN];
-        let followed = follow_chirps(&y, 1000.0, 200.0, &first, 32.0, 1.0, 0.1);
+        let followed = follow_chirps(&y, 1000.0, 200.0, &first, 32.0, 1.0, 0.1, 1);
         assert!(followed[0].is_nan());
         assert_eq!(followed[1], 200.0);
     }

@@ -258,12 +258,9 @@ fn harmonics_enf(
                 // twice: the first pass's steps bend the sweep rates the second one uses
                 let m = m as f64;
                 let reach = FOLLOW_REACH_HZ * m;
-                for _ in 0..2 {
-                    let line: Vec<f64> = corrected.iter().map(|f| f * m).collect();
-                    let followed =
-                        follow_chirps(&y, fs, center, &line, p.window_s, p.step_s, reach);
-                    corrected = followed.iter().map(|f| f / m).collect();
-                }
+                let line: Vec<f64> = corrected.iter().map(|f| f * m).collect();
+                let followed = follow_chirps(&y, fs, center, &line, p.window_s, p.step_s, reach, 2);
+                corrected = followed.iter().map(|f| f / m).collect();
             }
             HarmonicEstimates {
                 harmonic: m,
