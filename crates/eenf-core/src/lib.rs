@@ -9,6 +9,8 @@
 
 pub mod batch;
 pub mod grid;
+pub mod signal;
 
 pub use batch::EventBatch;
 pub use grid::Nominal;
+pub use signal::Signal;

@@ -4,7 +4,8 @@
 //! library with the GIL released, and turns the result into numpy arrays, a `Trace` or a dict
 //! (as JSON text, which `eenf/__init__.py` loads). Keyword arguments reach here as the
 //! command line's flags (`window=8` → `--window 8`) and are parsed by the same option sets
-//! (`eenf::args`) as the `eenf` command, so names, defaults, checks and messages are the CLI's.
+//! (`eenf_cli::args`) as the `eenf` command, so names, defaults and checks are the CLI's;
+//! errors name keyword arguments, not flags.
 //! The friendly signatures, structured arrays and plots live in `python/eenf/__init__.py`.
 
 #![forbid(unsafe_code)]
@@ -13,14 +14,14 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use clap::{Args as ClapArgs, FromArgMatches};
-use eenf::args::{
+use eenf::audio::Sound;
+use eenf::progress::Progress;
+use eenf::recording::Recording;
+use eenf::trace::Trace;
+use eenf_cli::args::{
     AudioArgs, EventOutputArgs, InputArgs, MatchArgs, MethodArgs, SimulateArgs, TrackerArgs,
     VideoMethodArgs,
 };
-use eenf::audio::Sound;
-use eenf::extract::Recording;
-use eenf::progress::Progress;
-use eenf::trace::Trace;
 use eenf_core::Nominal;
 use eenf_events::{EventBatch, EventReader};
 use numpy::{PyArray1, PyReadonlyArray1};
@@ -31,11 +32,49 @@ use pyo3::prelude::*;
 /// `eenf.EVENT_DTYPE` views them as).
 const RECORD: usize = 13;
 
+/// A message in Python's words: a flag (`--window <WINDOW>`, `--no-wait`) becomes the keyword
+/// argument that sets it (`window`, `no_wait`), and clap's "unexpected argument" an
+/// "unexpected keyword argument".
+fn python_names(msg: &str) -> String {
+    let msg = msg.replace("unexpected argument", "unexpected keyword argument");
+    let mut out = String::with_capacity(msg.len());
+    let mut rest = msg.as_str();
+    while let Some(i) = rest.find("--") {
+        let (before, after) = rest.split_at(i);
+        let name_len = after[2..]
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+            .unwrap_or(after.len() - 2);
+        let name = &after[2..2 + name_len];
+        out.push_str(before);
+        if name.starts_with(|c: char| c.is_ascii_lowercase()) {
+            out.push_str(&name.replace('-', "_"));
+            rest = &after[2 + name_len..];
+            // clap's value placeholder (` <WINDOW>`) goes with the flag
+            if let Some(tail) = rest.strip_prefix(" <") {
+                if let Some(end) = tail.find('>') {
+                    if tail[..end]
+                        .chars()
+                        .all(|c| c.is_ascii_uppercase() || c == '_')
+                    {
+                        rest = &tail[end + 1..];
+                    }
+                }
+            }
+        } else {
+            out.push_str("--");
+            rest = &after[2..];
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
 /// An error of the library as a Python exception: `OSError` (the subclass Python picks for
 /// the OS error's kind, e.g. `FileNotFoundError`) when a file could not be read or written,
-/// `ValueError` for bad data or parameters. The message is the CLI's.
+/// `ValueError` for bad data or parameters. Flags in the message are named as keyword
+/// arguments.
 fn py_err(e: anyhow::Error) -> PyErr {
-    let msg = format!("{e:#}");
+    let msg = python_names(&format!("{e:#}"));
     for cause in e.chain() {
         let kind = match cause.downcast_ref::<eenf_events::EventError>() {
             Some(eenf_events::EventError::Io { error, .. }) => Some(error.kind()),
@@ -58,10 +97,10 @@ fn parse<T: ClapArgs + FromArgMatches>(what: &'static str, argv: Vec<String>) ->
     let bad = |e: clap::Error| {
         let text = e.render().to_string();
         let line = text.lines().next().unwrap_or("bad arguments").trim();
-        PyValueError::new_err(format!(
+        PyValueError::new_err(python_names(&format!(
             "{what}: {}",
             line.strip_prefix("error: ").unwrap_or(line)
-        ))
+        )))
     };
     let m = cmd.try_get_matches_from(argv).map_err(bad)?;
     T::from_arg_matches(&m).map_err(bad)

@@ -88,6 +88,10 @@ def test_match_equals_the_command_line(cli, sim, tmp_path):
     again = eenf.match(eenf.Trace.read(path), refs, top=3, tz="+08:00")
     assert [c["offset_steps"] for c in again["candidates"]] == [
         c["offset_steps"] for c in want["candidates"]]
+    # local file names without their zone: the library's refusal names the keyword, not the flag
+    with pytest.raises(ValueError, match="tz") as e:
+        eenf.match(path, refs, top=3)
+    assert "--" not in str(e.value)
 
 
 def test_trace_files_round_trip(sim, tmp_path):

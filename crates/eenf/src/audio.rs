@@ -17,7 +17,7 @@ use symphonia::core::io::MediaSourceStream;
 use symphonia::core::meta::MetadataOptions;
 use symphonia::core::probe::Hint;
 
-use crate::wav::Signal;
+use eenf_core::Signal;
 
 /// Which channel of a recording is traced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -74,6 +74,8 @@ pub struct Audio {
     pub frames: u64,
     /// What decoded it: `symphonia` or `ffmpeg`.
     pub decoder: &'static str,
+    /// Damage the decoder skipped (packets lost), for the user.
+    pub warning: Option<String>,
 }
 
 /// Mixes or picks one channel of interleaved frames and feeds the decimator.
@@ -297,7 +299,7 @@ pub fn audio_from_samples(
     for block in interleaved.chunks(channels * 4096) {
         sink.push(block);
     }
-    finish(Some(sink), fs, name, "memory")
+    finish(Some(sink), fs, name, "memory", None)
 }
 
 /// Why Symphonia could not read a file: a format it does not know (ffmpeg may), or a real
@@ -388,16 +390,22 @@ fn read_symphonia(
             }
         }
     }
-    if damaged > 0 {
-        eprintln!(
-            "warning: {}: {damaged} damaged audio packets skipped",
+    let warning = (damaged > 0).then(|| {
+        format!(
+            "{}: {damaged} damaged audio packets skipped",
             path.display()
-        );
-    }
-    finish(sink, fs, path, "symphonia").map_err(Unreadable::Other)
+        )
+    });
+    finish(sink, fs, path, "symphonia", warning).map_err(Unreadable::Other)
 }
 
-fn finish(sink: Option<Sink>, fs: f64, path: &Path, decoder: &'static str) -> Result<Audio> {
+fn finish(
+    sink: Option<Sink>,
+    fs: f64,
+    path: &Path,
+    decoder: &'static str,
+    warning: Option<String>,
+) -> Result<Audio> {
     let Some(s) = sink.filter(|s| s.frames > 0) else {
         bail!("{}: the recording holds no sound", path.display());
     };
@@ -414,6 +422,7 @@ fn finish(sink: Option<Sink>, fs: f64, path: &Path, decoder: &'static str) -> Re
         channels: s.channels,
         frames: s.frames,
         decoder,
+        warning,
     })
 }
 
@@ -480,13 +489,13 @@ fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
             err.lines().last().unwrap_or("no message")
         );
     }
-    if let Some(last) = err.lines().last() {
-        eprintln!(
-            "warning: {}: ffmpeg met damage and skipped it ({last})",
+    let warning = err.lines().last().map(|last| {
+        format!(
+            "{}: ffmpeg met damage and skipped it ({last})",
             path.display()
-        );
-    }
-    finish(Some(sink), fs as f64, path, "ffmpeg")
+        )
+    });
+    finish(Some(sink), fs as f64, path, "ffmpeg", warning)
 }
 
 /// The last `keep` bytes (about) of what `r` gives, as text.
@@ -536,4 +545,14 @@ fn decode_ffmpeg_output(
         carry = have - whole;
     }
     Ok(sink)
+}
+
+/// Reads the first channel of a mains recording (WAV or any format [`crate::audio`] reads) at
+/// its own rate.
+pub fn read_wav(path: &Path) -> Result<Signal> {
+    let opts = AudioOptions {
+        channel: Channel::Index(0),
+        top_hz: None,
+    };
+    Ok(read_audio(path, &opts)?.signal)
 }

@@ -6,8 +6,8 @@ use eenf_dsp::{flicker_lines, line_strength_at, FlickerLine};
 use eenf_events::OpenOptions;
 use rayon::prelude::*;
 
-use crate::extract::Recording;
 use crate::progress::Progress;
+use crate::recording::Recording;
 
 /// Seconds of the recording the map looks at (the line is steady; memory stays bounded).
 pub const MAP_SECONDS: f64 = 64.0;

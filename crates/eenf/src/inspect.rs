@@ -7,7 +7,8 @@ use anyhow::Result;
 use eenf_dsp::{flicker_line, FlickerLine, Grouping, SamplingMethod, TemporalSampler};
 use eenf_events::{OpenOptions, StreamInfo, StreamStats};
 
-use crate::extract::{camera_line, Recording};
+use crate::extract::camera_line;
+use crate::recording::Recording;
 
 /// The flicker of one camera.
 #[derive(Debug, Clone, serde::Serialize)]

@@ -1,23 +1,24 @@
 //! # eenf
 //!
-//! The library behind the `eenf` command: every command is a thin layer over these modules,
-//! which tests, benchmarks and (later) the Python package call directly. The data path:
+//! The library behind the `eenf` command (crate `eenf-cli`) and the Python package: every
+//! command is a thin layer over these modules. The library knows no command line: it prints
+//! nothing, draws nothing, and reports progress to a [`progress::Progress`] its caller
+//! supplies; what the user should be told comes back in the results (a trace's notes and
+//! warnings). The data path:
 //!
 //! - [`extract`]: an event recording → its polarity sequence → a [`trace::Trace`] (E-ENF);
 //!   [`video`]: a video → a `Trace` (V-ENF); [`reference`]: a mains recording → a `Trace`.
 //! - [`evaluate`]: a `Trace` against its reference → an `Agreement` (CC, MAE, RMSE, max).
 //! - [`refdb`] and [`reference::ReferenceSeries`]: long references that `match` searches.
-//! - [`bench`]: every method over a dataset, Table 2 and figures; [`simulation`] and
+//! - [`bench`]: every method over a dataset, Table 2 and its reports; [`simulation`] and
 //!   [`dataset`]: simulated recordings and datasets with their truth.
 //!
-//! [`args`] holds the option sets of the command line, parsed into the library's types, which the
-//! `eenf` command and the Python package share (names, defaults, checks and messages).
-//! [`trace`] reads and writes traces, [`output`] writes every file whole or not at all,
-//! [`time`] holds all calendar and time-zone work.
+//! [`recording`] is what E-ENF reads (a file or events in memory); [`trace`] reads and writes
+//! traces, [`output`] writes every file whole or not at all, [`time`] holds all calendar and
+//! time-zone work.
 
 #![forbid(unsafe_code)]
 
-pub mod args;
 pub mod audio;
 pub mod bench;
 pub mod dataset;
@@ -26,8 +27,8 @@ pub mod extract;
 pub mod flicker_map;
 pub mod inspect;
 pub mod output;
-pub mod plot;
 pub mod progress;
+pub mod recording;
 pub mod refdb;
 pub mod reference;
 pub mod simulation;

@@ -3,8 +3,8 @@
 //! complete; a symlink's real file is the target (the link stays); a device, a FIFO or `-`
 //! (stdout) is written into (renaming over `/dev/null` would replace the device), from a
 //! temporary copy so that it too gets the whole output or nothing. Missing parent folders are
-//! created. Temporary files (and folders being built) are removed on errors and, after
-//! [`clean_up_on_signals`], when the program is interrupted.
+//! created. Temporary files (and folders being built) are removed on errors and, through
+//! [`remove_in_progress`], when the program is interrupted.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -31,27 +31,19 @@ pub fn forget_in_progress(path: &Path) {
     }
 }
 
-/// On SIGINT, SIGTERM or SIGHUP: removes every temporary file and folder in progress, then
-/// ends the program with the usual status (128 + the signal). Call once, early in `main`.
-pub fn clean_up_on_signals() -> Result<()> {
-    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
-    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
-        .context("cannot install the signal handlers")?;
-    std::thread::spawn(move || {
-        if let Some(sig) = signals.forever().next() {
-            // the lock is held only for short pushes and removals: waiting for it is brief
-            let paths = IN_PROGRESS.lock().map(|v| v.clone()).unwrap_or_default();
-            for p in paths.iter().rev() {
-                if p.is_dir() {
-                    let _ = std::fs::remove_dir_all(p);
-                } else {
-                    let _ = std::fs::remove_file(p);
-                }
-            }
-            std::process::exit(128 + sig);
+/// Removes every temporary file and folder in progress (newest first). The command line calls
+/// it when a signal (SIGINT, SIGTERM, SIGHUP) ends the program, so that no half-written output
+/// stays behind.
+pub fn remove_in_progress() {
+    // the lock is held only for short pushes and removals: waiting for it is brief
+    let paths = IN_PROGRESS.lock().map(|v| v.clone()).unwrap_or_default();
+    for p in paths.iter().rev() {
+        if p.is_dir() {
+            let _ = std::fs::remove_dir_all(p);
+        } else {
+            let _ = std::fs::remove_file(p);
         }
-    });
-    Ok(())
+    }
 }
 
 /// True when `path` names stdout (`-`).

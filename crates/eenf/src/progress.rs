@@ -1,71 +1,144 @@
-//! Progress bars on a terminal; nothing when output is piped or `--quiet` is given.
+//! Progress, reported to whoever called: the library draws nothing itself. The command line
+//! hands in a sink that draws bars on a terminal; the Python package and tests use
+//! [`Progress::hidden`].
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
+use std::sync::Arc;
 
-/// Makes progress bars, or hidden ones when nobody is watching.
-#[derive(Debug, Clone, Copy)]
+/// What a piece of work counts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    /// Events read (the total is the header's count, when it has one).
+    Events,
+    /// Steps of known number: frames, files, recordings.
+    Steps,
+    /// Work of unknown length: nothing is counted, only time passes.
+    Spinner,
+}
+
+/// Receives the progress of the library's work: one [`Task`] per piece of work started.
+pub trait ProgressSink: Send + Sync {
+    /// A piece of work named `what` starts, counting `unit`s up to `total` when known.
+    fn start(&self, unit: Unit, total: Option<u64>, what: &str) -> Box<dyn Task>;
+}
+
+/// One piece of work in progress, as the sink shows it.
+pub trait Task: Send + Sync {
+    /// `n` more units are done.
+    fn inc(&self, n: u64);
+    /// `n` units are done in all.
+    fn set_position(&self, n: u64);
+    /// The work is over (finished or abandoned): its display goes away.
+    fn finish(&self);
+}
+
+/// Where the library reports progress: a sink the caller supplies, or nowhere.
+#[derive(Clone, Default)]
 pub struct Progress {
-    visible: bool,
+    sink: Option<Arc<dyn ProgressSink>>,
+}
+
+impl std::fmt::Debug for Progress {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Progress")
+            .field("reported", &self.sink.is_some())
+            .finish()
+    }
 }
 
 impl Progress {
-    /// Bars are shown only when stderr is a terminal and `quiet` is false.
-    pub fn new(quiet: bool) -> Self {
-        Progress {
-            visible: !quiet && std::io::stderr().is_terminal(),
-        }
-    }
-
-    /// A progress object that never draws.
+    /// Progress that goes nowhere.
     pub fn hidden() -> Self {
-        Progress { visible: false }
+        Progress { sink: None }
     }
 
-    fn target(&self) -> ProgressDrawTarget {
-        if self.visible {
-            ProgressDrawTarget::stderr()
-        } else {
-            ProgressDrawTarget::hidden()
+    /// Progress reported to `sink`.
+    pub fn to(sink: Arc<dyn ProgressSink>) -> Self {
+        Progress { sink: Some(sink) }
+    }
+
+    fn start(&self, unit: Unit, total: Option<u64>, what: &str) -> Bar {
+        Bar(self.sink.as_ref().map(|s| s.start(unit, total, what)))
+    }
+
+    /// Work over events (`total` from the header, when it says).
+    pub fn events(&self, total: Option<u64>, what: &str) -> Bar {
+        self.start(Unit::Events, total, what)
+    }
+
+    /// Work over a number of steps (0: not known yet).
+    pub fn steps(&self, total: u64, what: &str) -> Bar {
+        self.start(Unit::Steps, Some(total), what)
+    }
+
+    /// Work of unknown length.
+    pub fn spinner(&self, what: &str) -> Bar {
+        self.start(Unit::Spinner, None, what)
+    }
+}
+
+/// A piece of work in progress; reporting on a hidden one costs nothing.
+pub struct Bar(Option<Box<dyn Task>>);
+
+impl Bar {
+    /// `n` more units are done.
+    pub fn inc(&self, n: u64) {
+        if let Some(t) = &self.0 {
+            t.inc(n);
         }
     }
 
-    /// A bar over events (a spinner with a count when the total is unknown).
-    pub fn events(&self, total: Option<u64>, what: &str) -> ProgressBar {
-        let bar = match total {
-            Some(n) => ProgressBar::with_draw_target(Some(n), self.target()).with_style(
-                ProgressStyle::with_template(
-                    "{msg} [{bar:30}] {human_pos}/{human_len} events ({per_sec}, eta {eta})",
-                )
-                .unwrap()
-                .progress_chars("=> "),
-            ),
-            None => ProgressBar::with_draw_target(None, self.target()).with_style(
-                ProgressStyle::with_template("{spinner} {msg} {human_pos} events ({per_sec})")
-                    .unwrap(),
-            ),
-        };
-        bar.set_message(what.to_string());
-        bar
+    /// `n` units are done in all.
+    pub fn set_position(&self, n: u64) {
+        if let Some(t) = &self.0 {
+            t.set_position(n);
+        }
     }
 
-    /// A bar over a number of steps.
-    pub fn steps(&self, total: u64, what: &str) -> ProgressBar {
-        let bar = ProgressBar::with_draw_target(Some(total), self.target()).with_style(
-            ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} (eta {eta})")
-                .unwrap()
-                .progress_chars("=> "),
-        );
-        bar.set_message(what.to_string());
-        bar
+    /// The work is over: its display goes away.
+    pub fn finish_and_clear(&self) {
+        if let Some(t) = &self.0 {
+            t.finish();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    /// Counts what it is told.
+    #[derive(Default)]
+    struct Counter(Arc<AtomicU64>);
+    struct Counted(Arc<AtomicU64>);
+
+    impl ProgressSink for Counter {
+        fn start(&self, _: Unit, _: Option<u64>, _: &str) -> Box<dyn Task> {
+            Box::new(Counted(self.0.clone()))
+        }
+    }
+    impl Task for Counted {
+        fn inc(&self, n: u64) {
+            self.0.fetch_add(n, Ordering::Relaxed);
+        }
+        fn set_position(&self, n: u64) {
+            self.0.store(n, Ordering::Relaxed);
+        }
+        fn finish(&self) {}
     }
 
-    /// A spinner for work of unknown length.
-    pub fn spinner(&self, what: &str) -> ProgressBar {
-        let bar = ProgressBar::with_draw_target(None, self.target())
-            .with_style(ProgressStyle::with_template("{spinner} {msg} ({elapsed})").unwrap());
-        bar.set_message(what.to_string());
-        bar.enable_steady_tick(std::time::Duration::from_millis(120));
-        bar
+    #[test]
+    fn a_supplied_sink_hears_the_work_and_a_hidden_one_costs_nothing() {
+        let count = Arc::new(AtomicU64::new(0));
+        let p = Progress::to(Arc::new(Counter(count.clone())));
+        let bar = p.events(Some(10), "reading");
+        bar.inc(3);
+        bar.inc(4);
+        assert_eq!(count.load(Ordering::Relaxed), 7);
+        bar.set_position(2);
+        assert_eq!(count.load(Ordering::Relaxed), 2);
+        let hidden = Progress::hidden().steps(5, "nothing");
+        hidden.inc(1);
+        assert_eq!(count.load(Ordering::Relaxed), 2);
     }
 }

@@ -63,18 +63,16 @@ pub struct StoreLock(#[allow(dead_code)] Option<File>);
 
 impl StoreLock {
     /// The exclusive lock of the store at `dir` (created if need be), for a change. When
-    /// another process holds it, waits for it, or with `wait` false fails saying so.
-    pub fn exclusive(dir: &Path, wait: bool) -> Result<Self> {
+    /// another process holds it, calls `on_wait` and waits for it, or with `wait` false fails
+    /// saying so.
+    pub fn exclusive(dir: &Path, wait: bool, on_wait: impl FnOnce()) -> Result<Self> {
         std::fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
         let path = dir.join(LOCK_FILE);
         let file = open_lock_file(&path).with_context(|| format!("{}", path.display()))?;
         match file.try_lock() {
             Ok(()) => {}
             Err(std::fs::TryLockError::WouldBlock) if wait => {
-                eprintln!(
-                    "{}: another build is changing this store; waiting for it",
-                    dir.display()
-                );
+                on_wait();
                 file.lock().with_context(|| format!("{}", path.display()))?;
             }
             Err(std::fs::TryLockError::WouldBlock) => bail!(

@@ -14,14 +14,15 @@ use eenf_dsp::{
     EnfParams,
 };
 
+use crate::audio::read_wav;
 use crate::audio::{AudioOptions, Sound};
 use crate::dataset::hourly_references;
 use crate::progress::Progress;
 use crate::refdb::{RefSeries, GAP};
 use crate::time::LocalTime;
 use crate::trace::{AudioProvenance, HumReport, MainsProvenance, Provenance, Trace};
-use crate::wav::{read_wav, Signal};
 use eenf_core::Nominal;
+use eenf_core::Signal;
 
 /// Decides or checks the nominal frequency of a mains signal: the line detector on f0 alone.
 pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<f64> {
@@ -180,6 +181,7 @@ pub fn sound_trace(
                 m.audio = Some(provenance_audio(a.signal.fs));
             }
         }
+        t.warnings.extend(a.warning.clone());
         return Ok(t);
     }
     if duration_s < MIN_CLIP_S {
@@ -251,6 +253,7 @@ pub fn sound_trace(
             plausibility,
         });
     }
+    trace.warnings.extend(a.warning.clone());
     Ok(trace)
 }
 

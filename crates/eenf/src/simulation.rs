@@ -8,13 +8,14 @@ use anyhow::{bail, Context, Result};
 use eenf_events::writers::OutputFormat;
 use eenf_sim::{simulate, CameraConfig, MainsPhase, SimConfig, SimStats, SyntheticEnf};
 
+use crate::audio::read_wav;
 use crate::dataset::{hourly_references, reference_name};
 use crate::output::{sibling, write_atomic, write_events};
 use crate::progress::Progress;
 use crate::reference::mains_nominal;
 use crate::time::{offset_of, parse_time, LocalTime};
 use crate::trace::Trace;
-use crate::wav::{is_wav, read_wav, write_wav};
+use crate::wav::{is_wav, write_wav};
 use eenf_core::Nominal;
 
 /// Sampling rate of synthesized mains references (the dataset's).
@@ -383,7 +384,7 @@ pub fn parse_cameras(list: &str, scale: f64) -> anyhow::Result<Vec<eenf_sim::Cam
 
 /// Renders the same scene and lighting as `config` through `camera` into
 /// `<stem>_<camera>.y4m` beside `output` (and `.mp4` too when `mp4` and ffmpeg is there).
-/// Returns the files written.
+/// Returns the files written, and a note when the MP4 could not be made.
 pub fn write_video(
     config: &SimConfig,
     camera: &eenf_sim::CameraConfig,
@@ -391,7 +392,7 @@ pub fn write_video(
     output: &Path,
     mp4: bool,
     progress: &Progress,
-) -> anyhow::Result<Vec<PathBuf>> {
+) -> anyhow::Result<VideoFiles> {
     camera
         .check()
         .map_err(|e| anyhow::anyhow!("camera {}: {e}", camera.name))?;
@@ -410,6 +411,7 @@ pub fn write_video(
     })?;
     bar.finish_and_clear();
     let mut written = vec![y4m.clone()];
+    let mut note = None;
     if mp4 {
         let mp4_path = y4m.with_extension("mp4");
         let tool = std::env::var("EENF_FFMPEG").unwrap_or_else(|_| "ffmpeg".into());
@@ -426,10 +428,21 @@ pub fn write_video(
         match status {
             Ok(s) if s.success() => written.push(mp4_path),
             Ok(s) => anyhow::bail!("{}: ffmpeg failed ({s})", mp4_path.display()),
-            Err(e) => eprintln!("note: no MP4 ({tool}: {e}); the Y4M is written"),
+            Err(e) => note = Some(format!("no MP4 ({tool}: {e}); the Y4M is written")),
         }
     }
-    Ok(written)
+    Ok(VideoFiles {
+        files: written,
+        note,
+    })
+}
+
+/// What [`write_video`] wrote.
+pub struct VideoFiles {
+    /// The Y4M, then the MP4 when one was made.
+    pub files: Vec<PathBuf>,
+    /// Why no MP4 was made when one was asked for (ffmpeg missing).
+    pub note: Option<String>,
 }
 
 /// Where a simulated recording's ENF comes from.
@@ -503,6 +516,8 @@ pub struct SimulatedRecording {
     pub videos: Vec<PathBuf>,
     /// Reference WAVs written.
     pub references: Vec<PathBuf>,
+    /// What the caller should be told (a video without its MP4).
+    pub notes: Vec<String>,
 }
 
 /// The local start (seconds) and UTC offset of a recording starting at `start`, or
@@ -565,10 +580,11 @@ pub fn simulate_recording(r: &Recipe, progress: &Progress) -> Result<SimulatedRe
     });
     let sim = write_recording(&config, &mains, &r.output, r.format, extra, progress)?;
     let mut videos = Vec::new();
+    let mut notes = Vec::new();
     for camera in &r.cameras {
-        videos.extend(write_video(
-            &config, camera, &mains, &r.output, r.mp4, progress,
-        )?);
+        let v = write_video(&config, camera, &mains, &r.output, r.mp4, progress)?;
+        videos.extend(v.files);
+        notes.extend(v.note);
     }
     let references = match &r.reference_dir {
         Some(dir) => {
@@ -582,5 +598,6 @@ pub fn simulate_recording(r: &Recipe, progress: &Progress) -> Result<SimulatedRe
         local_start: start,
         videos,
         references,
+        notes,
     })
 }

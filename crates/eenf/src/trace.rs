@@ -203,6 +203,8 @@ pub struct Trace {
     pub selected: Vec<SelectedSegment>,
     /// Where it came from.
     pub provenance: Option<Provenance>,
+    /// What the caller should show the user: damage a decoder skipped, for instance.
+    pub warnings: Vec<String>,
 }
 
 /// The JSON layout (keys come out sorted, as `serde_json` maps keep them).
@@ -223,6 +225,8 @@ struct TraceJson {
     harmonics: Vec<HarmonicPart>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     selected: Vec<SelectedSegment>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    warnings: Vec<String>,
 }
 
 /// Seconds `0, step, 2·step, …` for `n` estimates.
@@ -427,6 +431,7 @@ impl Trace {
             snr_db: self.snr_db.clone(),
             harmonics: self.harmonics.clone(),
             selected: self.selected.clone(),
+            warnings: self.warnings.clone(),
         };
         // serialising plain data into a JSON value cannot fail
         let mut v = serde_json::to_value(core).unwrap_or_default();
@@ -535,6 +540,7 @@ impl Trace {
             snr_db: core.snr_db,
             harmonics: core.harmonics,
             selected: core.selected,
+            warnings: core.warnings,
             provenance: serde_json::from_value(v).ok(),
         })
     }

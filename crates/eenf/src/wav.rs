@@ -1,28 +1,9 @@
-//! Mains recordings as WAV: the first channel read at its own rate (through [`crate::audio`]),
-//! and 16-bit mono WAVs written.
+//! WAV files: 16-bit mono WAVs written whole, and RIFF/WAVE recognised. Reading goes through
+//! [`crate::audio`], which reads every container.
 
 use std::path::Path;
 
 use anyhow::Result;
-
-/// Samples of a mono signal.
-#[derive(Debug, Clone)]
-pub struct Signal {
-    /// Sampling rate, Hz.
-    pub fs: f64,
-    /// Samples (scaled to ±1 for integer formats).
-    pub samples: Vec<f64>,
-}
-
-/// Reads the first channel of a mains recording (WAV or any format [`crate::audio`] reads) at
-/// its own rate.
-pub fn read_wav(path: &Path) -> Result<Signal> {
-    let opts = crate::audio::AudioOptions {
-        channel: crate::audio::Channel::Index(0),
-        top_hz: None,
-    };
-    Ok(crate::audio::read_audio(path, &opts)?.signal)
-}
 
 /// Writes a mono 16-bit WAV (samples in ±1), whole or not at all.
 pub fn write_wav(path: &Path, fs: u32, samples: &[f64]) -> Result<()> {

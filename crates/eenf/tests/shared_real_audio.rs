@@ -6,10 +6,10 @@
 
 use std::path::{Path, PathBuf};
 
+use eenf::audio::read_wav;
 use eenf::audio::{AudioOptions, Sound};
 use eenf::reference::{audio_trace, reference_file, sound_trace, HumOptions};
 use eenf::trace::{Provenance, Trace};
-use eenf::wav::read_wav;
 use eenf_core::Nominal;
 use eenf_dsp::{agreement, search_hum, EnfParams};
 use eenf_sim::MainsPhase;

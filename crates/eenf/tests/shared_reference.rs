@@ -102,7 +102,7 @@ fn simulation_driven_by_a_real_hour_is_recovered() {
     use eenf_sim::{simulate, MainsPhase, SimConfig};
 
     let wav = shared().join("enf-reference/2022_08_17_Wed_16_00_00.wav");
-    let sig = eenf::wav::read_wav(&wav).unwrap();
+    let sig = eenf::audio::read_wav(&wav).unwrap();
     let start = 600.0;
     let config = SimConfig {
         duration_s: 120.0,

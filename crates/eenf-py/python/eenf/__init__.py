@@ -11,8 +11,8 @@ arrays in and out:
 
 Keyword parameters have the command line's names and defaults (``window=16`` is
 ``--window 16``); ``help(eenf.extract)`` lists them. Errors are ``OSError`` (a file that
-cannot be read or written) or ``ValueError`` (bad data or parameters) with the command line's
-messages. A recording read only in part (damage, a wild timestamp) gives an
+cannot be read or written) or ``ValueError`` (bad data or parameters); their messages name
+keyword arguments (``window``), not the command line's flags. A recording read only in part (damage, a wild timestamp) gives an
 :class:`EenfWarning` and the readable part. The work runs with the GIL released.
 """
 

@@ -2,12 +2,12 @@
 
 use std::path::PathBuf;
 
+use crate::plot::plot_extraction;
 use anyhow::Result;
 use eenf::extract::extract_file;
-use eenf::plot::plot_extraction;
 use eenf::progress::Progress;
 
-use eenf::args::{MethodArgs, TraceOutputArgs};
+use crate::args::{MethodArgs, TraceOutputArgs};
 
 /// Arguments of `eenf extract`.
 #[derive(Debug, clap::Args)]
@@ -23,6 +23,7 @@ pub struct Args {
     pub method: MethodArgs,
 }
 
+/// Runs `eenf extract`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let opts = a.method.options()?;
     let started = std::time::Instant::now();

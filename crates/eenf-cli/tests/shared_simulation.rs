@@ -2,6 +2,7 @@
 //! are those recordings, and E-ENF scored on it per class. Needs `../shared` (run by `.ci/run`
 //! with `--ignored`).
 
+#[path = "../../eenf/tests/common/mod.rs"]
 mod common;
 
 use std::path::Path;

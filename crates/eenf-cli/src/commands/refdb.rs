@@ -49,7 +49,7 @@ pub struct BuildArgs {
     #[arg(long)]
     pub no_wait: bool,
     /// Seconds between values of `index` CSVs.
-    #[arg(long, value_parser = eenf::args::number_in(0.001, 3600.0))]
+    #[arg(long, value_parser = crate::args::number_in(0.001, 3600.0))]
     pub step: Option<f64>,
 }
 
@@ -59,7 +59,12 @@ fn build(a: BuildArgs, progress: Progress) -> Result<()> {
         check_grid_name(g)?;
     }
     // the whole read-merge-write under the store's lock: a second build waits for this one
-    let _lock = StoreLock::exclusive(&a.store, !a.no_wait)?;
+    let _lock = StoreLock::exclusive(&a.store, !a.no_wait, || {
+        eprintln!(
+            "{}: another build is changing this store; waiting for it",
+            a.store.display()
+        )
+    })?;
     let bar = progress.steps(a.inputs.len() as u64, "adding references");
     let mut series: Vec<RefSeries> = Vec::new();
     let mut next_start = a.start.as_deref().map(parse_time).transpose()?;
@@ -192,6 +197,7 @@ fn nominal_of(trace: &Trace, path: &Path) -> Result<f64> {
     })
 }
 
+/// Runs `eenf refdb`.
 pub fn run(cmd: Cmd, progress: Progress) -> Result<()> {
     match cmd {
         Cmd::Build(a) => build(a, progress),

@@ -2,15 +2,15 @@
 
 use std::path::PathBuf;
 
+use crate::plot::plot_comparison;
 use anyhow::Result;
 use eenf::evaluate::compare_trace;
-use eenf::plot::plot_comparison;
 use eenf::progress::Progress;
 use eenf::trace::Trace;
 use eenf_core::Nominal;
 use eenf_dsp::{EnfParams, PeakMethod};
 
-use eenf::args::one_of;
+use crate::args::one_of;
 
 /// Arguments of `eenf compare`.
 #[derive(Debug, clap::Args)]
@@ -23,11 +23,11 @@ pub struct Args {
     pub reference: PathBuf,
     /// Seconds to add to the estimate's times to reach the reference's times. Against one
     /// hourly WAV or a folder of them, the default places the recording by its `dvSave-…` name.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = eenf::args::number_in(-1e9, 1e9))]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = crate::args::number_in(-1e9, 1e9))]
     pub offset_s: f64,
     /// Seconds between the rows of an `index,value` CSV (estimate or reference), such as the
     /// published 60 Hz ENF traces.
-    #[arg(long, default_value_t = eenf::trace::INDEX_STEP_S, value_parser = eenf::args::number_in(0.001, 3600.0))]
+    #[arg(long, default_value_t = eenf::trace::INDEX_STEP_S, value_parser = crate::args::number_in(0.001, 3600.0))]
     pub index_step: f64,
     /// Print JSON instead of text.
     #[arg(long)]
@@ -43,6 +43,7 @@ pub struct Args {
     pub peak: Option<PeakMethod>,
 }
 
+/// Runs `eenf compare`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     if a.index_step.is_nan() || a.index_step <= 0.0 {
         anyhow::bail!("--index-step must be positive");

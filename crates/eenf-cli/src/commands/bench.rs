@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use eenf::bench::report::{
-    json_run, markdown_report, markdown_table, write_csv, write_plots, write_traces, ReportContext,
+    json_run, markdown_report, markdown_table, write_csv, write_traces, ReportContext,
 };
 use eenf::bench::run::{jobs_for, run_all};
 use eenf::bench::{discover, group_by_prominence, sweep, Method, Settings};
@@ -13,7 +13,7 @@ use eenf::progress::Progress;
 use eenf_core::Nominal;
 use eenf_video::{IdleRows, RowSampling, SceneRemoval, VideoOptions};
 
-use eenf::args::{one_of, MethodArgs};
+use crate::args::{one_of, MethodArgs};
 
 /// Arguments of `eenf bench`.
 #[derive(Debug, clap::Args)]
@@ -26,7 +26,7 @@ pub struct Args {
     #[arg(long, default_value = "e-enf,v-enf-lr,v-enf-hr")]
     pub methods: String,
     /// Recordings processed at once (default: one per core, fewer if the memory budget says so).
-    #[arg(long, value_parser = eenf::args::count_in(1, 256))]
+    #[arg(long, value_parser = crate::args::count_in(1, 256))]
     pub jobs: Option<usize>,
     /// Memory budget, MiB: bounds the recordings processed at once.
     #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u64).range(64..=1 << 30))]
@@ -64,6 +64,7 @@ pub struct Args {
     pub method: MethodArgs,
 }
 
+/// Runs `eenf bench`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let started = std::time::Instant::now();
     let methods = Method::parse_list(&a.methods)?;
@@ -146,7 +147,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         eprintln!("traces in {}", dir.display());
     }
     if let Some(dir) = &a.plots {
-        let n = write_plots(dir, &recs, &runs, &methods, &progress)?;
+        let n = crate::figures::write_plots(dir, &recs, &runs, &methods, &progress)?;
         eprintln!("{n} figures in {}", dir.display());
     }
     if let Some(p) = &a.report {

@@ -5,10 +5,10 @@
 use std::path::PathBuf;
 use std::str::FromStr;
 
-use crate::extract::ExtractOptions;
-use crate::simulation::{EnfSource, Recipe};
 use anyhow::{bail, Context, Result};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
+use eenf::extract::ExtractOptions;
+use eenf::simulation::{EnfSource, Recipe};
 use eenf_core::Nominal;
 use eenf_dsp::{EnfParams, HarmonicSelection, PeakMethod, SamplingMethod};
 use eenf_events::writers::OutputFormat;
@@ -272,7 +272,7 @@ impl VideoArgs {
     /// The cameras asked for (none without `--video`).
     pub fn cameras(&self) -> Result<Vec<eenf_sim::CameraConfig>> {
         match &self.video {
-            Some(list) => crate::simulation::parse_cameras(list, self.video_scale),
+            Some(list) => eenf::simulation::parse_cameras(list, self.video_scale),
             None => Ok(Vec::new()),
         }
     }
@@ -291,15 +291,15 @@ pub struct TraceOutputArgs {
 
 impl TraceOutputArgs {
     /// Writes the trace file, if one was asked for, and says so on stderr.
-    pub fn save(&self, trace: &crate::trace::Trace) -> Result<()> {
+    pub fn save(&self, trace: &eenf::trace::Trace) -> Result<()> {
         if let Some(out) = &self.output {
-            crate::output::write_atomic(out, |w| trace.write_for(out, w))?;
+            eenf::output::write_atomic(out, |w| trace.write_for(out, w))?;
         }
         Ok(())
     }
 
     /// Prints the trace on stdout: JSON with `--json`, else CSV unless it went to a file.
-    pub fn print(&self, trace: &crate::trace::Trace) -> Result<()> {
+    pub fn print(&self, trace: &eenf::trace::Trace) -> Result<()> {
         let stdout = std::io::stdout();
         let mut lock = stdout.lock();
         if self.json {
@@ -314,7 +314,7 @@ impl TraceOutputArgs {
     /// Says where the trace went (stderr).
     pub fn report(&self) {
         match &self.output {
-            Some(out) if crate::output::is_stdout(out) => {}
+            Some(out) if eenf::output::is_stdout(out) => {}
             Some(out) => eprintln!("trace written to {}", out.display()),
             None => {}
         }
@@ -384,27 +384,27 @@ pub fn parse_readout(s: &str) -> Result<eenf_sim::Readout> {
 pub struct AudioArgs {
     /// The channel traced: `mix` (the mean of all) or a number from 0.
     #[arg(long, default_value = "mix")]
-    pub channel: crate::audio::Channel,
+    pub channel: eenf::audio::Channel,
     /// Mains lines tracked: auto (every harmonic of 50 and 60 Hz up to 8·f0 is looked for;
     /// f0 alone is tracked when it carries the ENF clearly, else every harmonic that stands
     /// above its noise, band by band, the selection rule picking per segment); 1 tracks f0
     /// alone (the method's reference tracker); N tracks f0 … N·f0.
     #[arg(long, default_value = "auto")]
-    pub harmonics: crate::reference::MainsLines,
+    pub harmonics: eenf::reference::MainsLines,
 }
 
 impl AudioArgs {
     /// How the hum is traced: these lines, and the tracker's `--window` if one was given.
-    pub fn hum(&self, tracker: &TrackerArgs) -> crate::reference::HumOptions {
-        crate::reference::HumOptions {
+    pub fn hum(&self, tracker: &TrackerArgs) -> eenf::reference::HumOptions {
+        eenf::reference::HumOptions {
             lines: self.harmonics,
             window_s: tracker.window,
         }
     }
 
     /// The reading options (the rate follows from the harmonics tracked).
-    pub fn options(&self) -> crate::audio::AudioOptions {
-        crate::audio::AudioOptions {
+    pub fn options(&self) -> eenf::audio::AudioOptions {
+        eenf::audio::AudioOptions {
             channel: self.channel,
             top_hz: None,
         }
@@ -533,7 +533,7 @@ pub struct SimulateArgs {
     pub noise_hz: Option<f64>,
     /// Local start time of the recording (names, timestamps; a WAV or CSV source named with
     /// its time sets it).
-    #[arg(long, default_value = crate::simulation::DEFAULT_START)]
+    #[arg(long, default_value = eenf::simulation::DEFAULT_START)]
     pub start: String,
     /// Also write the hourly mains references (400 Hz WAVs named like the dataset's) that
     /// cover the recording into this folder.
@@ -657,8 +657,8 @@ pub struct MatchArgs {
 
 impl MatchArgs {
     /// What the search asks for.
-    pub fn query(&self) -> crate::reference::MatchQuery {
-        crate::reference::MatchQuery {
+    pub fn query(&self) -> eenf::reference::MatchQuery {
+        eenf::reference::MatchQuery {
             top: self.top,
             score: self.score,
             verify: self.verify.clone(),

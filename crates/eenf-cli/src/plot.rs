@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use crate::trace::Trace;
 use anyhow::{anyhow, bail, Result};
+use eenf::trace::Trace;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -52,7 +52,7 @@ fn render(
     if !matches!(ext.as_str(), "png" | "svg") {
         bail!("{}: plots are written as .png or .svg", path.display());
     }
-    let out = crate::output::AtomicFile::keeping_extension(path)?;
+    let out = eenf::output::AtomicFile::keeping_extension(path)?;
     let tmp = out.path().to_path_buf();
     let res = match ext.as_str() {
         "png" => {
@@ -649,7 +649,7 @@ fn colour_bar<DB: DrawingBackend>(
 fn flicker_map_chart<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
-    m: &crate::flicker_map::FlickerMap,
+    m: &eenf::flicker_map::FlickerMap,
 ) -> Result<()> {
     root.fill(&WHITE).map_err(e)?;
     let root = root.titled(title, ("sans-serif", 22)).map_err(e)?;
@@ -709,7 +709,7 @@ fn flicker_map_chart<DB: DrawingBackend>(
 pub fn plot_flicker_map(
     path: &Path,
     title: &str,
-    map: &crate::flicker_map::FlickerMap,
+    map: &eenf::flicker_map::FlickerMap,
 ) -> Result<()> {
     render(
         path,

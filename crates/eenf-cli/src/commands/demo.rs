@@ -2,11 +2,11 @@
 
 use std::path::PathBuf;
 
+use crate::plot::{plot_comparison, plot_extraction};
 use anyhow::{Context, Result};
 use eenf::evaluate::compare_trace;
 use eenf::extract::{extract_file, ExtractOptions};
 use eenf::output::{sibling, write_atomic};
-use eenf::plot::{plot_comparison, plot_extraction};
 use eenf::progress::Progress;
 use eenf::simulation::{simulate_recording, Recipe};
 use eenf::trace::Trace;
@@ -21,13 +21,14 @@ pub struct Args {
     #[arg(long, default_value = "eenf-demo")]
     pub out_dir: PathBuf,
     /// Length of the simulated recording, s.
-    #[arg(long, default_value_t = 60.0, value_parser = eenf::args::number_in(1.0, 3600.0))]
+    #[arg(long, default_value_t = 60.0, value_parser = crate::args::number_in(1.0, 3600.0))]
     pub duration: f64,
     /// Random seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
 }
 
+/// Runs `eenf demo`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("{}", a.out_dir.display()))?;
     let recording = a.out_dir.join("demo.aedat4");

@@ -7,7 +7,7 @@ use eenf::progress::Progress;
 use eenf::reference::audio_trace;
 use eenf::trace::{MainsProvenance, Provenance};
 
-use eenf::args::{AudioArgs, TraceOutputArgs, TrackerArgs};
+use crate::args::{AudioArgs, TraceOutputArgs, TrackerArgs};
 
 /// Arguments of `eenf reference`.
 #[derive(Debug, clap::Args)]
@@ -23,6 +23,7 @@ pub struct Args {
     pub tracker: TrackerArgs,
 }
 
+/// Runs `eenf reference`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let params = a.tracker.params()?;
     let spin = progress.spinner("tracking the mains frequency");
@@ -35,6 +36,9 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         &params,
     )?;
     spin.finish_and_clear();
+    for w in &trace.warnings {
+        eprintln!("warning: {w}");
+    }
     a.out.save(&trace)?;
     let finite: Vec<f64> = trace.finite().collect();
     let mean = finite.iter().sum::<f64>() / finite.len().max(1) as f64;

@@ -7,8 +7,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use eenf::audio::{AudioOptions, Channel, Sound};
-use eenf::extract::{extract, ExtractOptions, Recording};
+use eenf::extract::{extract, ExtractOptions};
 use eenf::progress::Progress;
+use eenf::recording::Recording;
 use eenf::reference::{sound_trace, HumOptions, MainsLines};
 use eenf_events::EventBatch;
 

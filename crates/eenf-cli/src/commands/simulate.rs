@@ -1,7 +1,7 @@
 //! `eenf simulate`: an event recording of a flickering scene, with its ground truth.
 
+use crate::args::SimulateArgs;
 use anyhow::Result;
-use eenf::args::SimulateArgs;
 use eenf::dataset::{recording_name, recording_start};
 use eenf::progress::Progress;
 use eenf::simulation::simulate_recording;
@@ -13,11 +13,15 @@ pub struct Args {
     pub sim: SimulateArgs,
 }
 
+/// Runs `eenf simulate`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let a = a.sim;
     let recipe = a.recipe()?;
     let r = simulate_recording(&recipe, &progress)?;
     let (sim, config) = (&r.sim, &r.config);
+    for n in &r.notes {
+        eprintln!("note: {n}");
+    }
     eprintln!(
         "simulated {:.0} s at {}x{}: {} events ({:.1} M events/s generated) in {:.1} s",
         a.duration,

@@ -2,15 +2,15 @@
 
 use std::path::PathBuf;
 
+use crate::plot::plot_comparison;
 use anyhow::Result;
-use eenf::plot::plot_comparison;
 use eenf::progress::Progress;
 use eenf::reference::{match_grid, match_trace_in, ReferenceSeries};
 use eenf::time::tz_offset;
 use eenf::trace::Trace;
 use eenf_dsp::matching::resample;
 
-use eenf::args::MatchArgs;
+use crate::args::MatchArgs;
 
 /// Arguments of `eenf match`.
 #[derive(Debug, clap::Args)]
@@ -30,6 +30,7 @@ pub struct Args {
     pub plot: Option<PathBuf>,
 }
 
+/// Runs `eenf match`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let trace = Trace::read(&a.trace, None)?;
     let nominal = match_grid(&trace, &a.trace)?;

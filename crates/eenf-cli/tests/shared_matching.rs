@@ -9,6 +9,7 @@ use eenf_core::Nominal;
 use eenf_dsp::matching::{match_trace, MatchOptions, DEFAULT_ALPHA};
 use eenf_dsp::EnfParams;
 
+#[path = "../../eenf/tests/common/mod.rs"]
 mod common;
 
 fn shared() -> PathBuf {
@@ -143,7 +144,7 @@ fn an_eenf_trace_from_a_simulated_recording_is_placed_at_its_time() {
     use eenf_sim::{simulate, MainsPhase, SimConfig};
 
     let wav = shared().join("enf-reference/2022_08_17_Wed_17_00_00.wav");
-    let sig = eenf::wav::read_wav(&wav).unwrap();
+    let sig = eenf::audio::read_wav(&wav).unwrap();
     let config = SimConfig {
         duration_s: 300.0,
         seed: 17,

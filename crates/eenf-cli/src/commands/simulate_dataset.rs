@@ -14,7 +14,7 @@ use eenf::time::{tz_offset, LocalTime};
 use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;
 
-use eenf::args::{one_of, parse_readout, parse_resolution, VideoArgs};
+use crate::args::{one_of, parse_readout, parse_resolution, VideoArgs};
 
 /// Arguments of `eenf simulate-dataset`.
 #[derive(Debug, Clone, clap::Args)]
@@ -46,7 +46,7 @@ pub struct Args {
     #[arg(long)]
     pub resolution: Option<String>,
     /// Length of every recording, s (default: the preset's).
-    #[arg(long, value_parser = eenf::args::number_in(0.01, 86_400.0))]
+    #[arg(long, value_parser = crate::args::number_in(0.01, 86_400.0))]
     pub duration: Option<f64>,
     /// Readout: dvxplorer, prophesee or dvs128 (the `lamp-spot` preset sets its own).
     #[arg(long, default_value = "dvxplorer")]
@@ -82,6 +82,7 @@ fn parse_local_hour(s: &str) -> Result<i64> {
     Ok(t.local_seconds())
 }
 
+/// Runs `eenf simulate-dataset`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let spec = DatasetSpec {
         preset: a.preset.clone(),
@@ -200,8 +201,12 @@ fn build(
         let mut videos = Vec::new();
         for camera in cameras {
             let hidden = Progress::hidden();
-            for v in write_video(&plan.config, camera, &mains, &path, a.video.mp4, &hidden)? {
-                videos.push(relative(&a.out_dir, &v));
+            let v = write_video(&plan.config, camera, &mains, &path, a.video.mp4, &hidden)?;
+            for f in &v.files {
+                videos.push(relative(&a.out_dir, f));
+            }
+            if let Some(n) = v.note {
+                eprintln!("note: {n}");
             }
         }
         let lamps: Vec<String> = plan

@@ -4,6 +4,7 @@
 //! file's flicker line. `#[ignore]`d (needs the shared data); `.ci/run` runs it.
 
 mod cli;
+#[path = "../../eenf/tests/common/mod.rs"]
 mod common;
 
 use std::path::PathBuf;

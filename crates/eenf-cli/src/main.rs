@@ -2,8 +2,7 @@
 
 #![forbid(unsafe_code)]
 
-mod commands;
-
+use eenf_cli::{commands, terminal};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -70,10 +69,10 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    if let Err(e) = eenf::output::clean_up_on_signals() {
+    if let Err(e) = terminal::clean_up_on_signals() {
         eprintln!("eenf: warning: {e:#}");
     }
-    let progress = eenf::progress::Progress::new(cli.quiet);
+    let progress = terminal::progress(cli.quiet);
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),
         Command::Convert(a) => commands::convert::run(a, progress),

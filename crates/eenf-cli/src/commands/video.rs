@@ -6,7 +6,7 @@ use anyhow::Result;
 use eenf::progress::Progress;
 use eenf::trace::Provenance;
 
-use eenf::args::{TraceOutputArgs, VideoMethodArgs};
+use crate::args::{TraceOutputArgs, VideoMethodArgs};
 
 /// Arguments of `eenf video`.
 #[derive(Debug, clap::Args)]
@@ -19,6 +19,7 @@ pub struct Args {
     pub method: VideoMethodArgs,
 }
 
+/// Runs `eenf video`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let opts = a.method.options()?;
     let started = std::time::Instant::now();

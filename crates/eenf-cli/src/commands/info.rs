@@ -6,7 +6,7 @@ use anyhow::Result;
 use eenf::inspect::{inspect, CameraFlicker};
 use eenf::time::utc_micros;
 
-use eenf::args::InputArgs;
+use crate::args::InputArgs;
 
 /// Arguments of `eenf info`.
 #[derive(Debug, clap::Args)]
@@ -51,6 +51,7 @@ fn flicker_text(f: &CameraFlicker) -> String {
     }
 }
 
+/// Runs `eenf info`.
 pub fn run(a: Args) -> Result<()> {
     let found = inspect(&a.file, &a.read.options())?;
     if a.json {

@@ -2,12 +2,12 @@
 
 use std::path::PathBuf;
 
+use crate::plot::plot_flicker_map;
 use anyhow::Result;
 use eenf::flicker_map::{flicker_map, MAP_SECONDS};
-use eenf::plot::plot_flicker_map;
 use eenf::progress::Progress;
 
-use eenf::args::InputArgs;
+use crate::args::InputArgs;
 
 /// Arguments of `eenf flicker-map`.
 #[derive(Debug, clap::Args)]
@@ -27,8 +27,9 @@ pub struct Args {
     pub read: InputArgs,
 }
 
+/// Runs `eenf flicker-map`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
-    let rec = eenf::extract::Recording::file(&a.file);
+    let rec = eenf::recording::Recording::file(&a.file);
     let map = flicker_map(&rec, &a.read.options(), a.tile, &progress)?;
     if let Some(d) = &map.damage {
         eprintln!("warning: {d}");

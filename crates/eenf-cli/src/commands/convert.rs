@@ -7,7 +7,7 @@ use eenf::output::write_events;
 use eenf::progress::Progress;
 use eenf_events::StreamStats;
 
-use eenf::args::{EventOutputArgs, InputArgs};
+use crate::args::{EventOutputArgs, InputArgs};
 
 /// Arguments of `eenf convert`.
 #[derive(Debug, clap::Args)]
@@ -22,6 +22,7 @@ pub struct Args {
     pub read: InputArgs,
 }
 
+/// Runs `eenf convert`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let format = a.events.format_for(&a.output, None)?;
     if a.input.canonicalize().ok() == a.output.canonicalize().ok() && a.output.exists() {
