@@ -146,6 +146,10 @@ pub enum Format {
 pub trait Source: Read + Seek + Send {}
 impl<T: Read + Seek + Send> Source for T {}
 
+/// Where a writer's bytes go: a file, a temporary file, a `Cursor<Vec<u8>>`.
+pub trait Sink: std::io::Write + Seek + Send {}
+impl<T: std::io::Write + Seek + Send> Sink for T {}
+
 /// Bytes looked at to decide a format.
 const HEAD: usize = 4096;
 

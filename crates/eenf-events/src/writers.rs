@@ -1,11 +1,11 @@
 //! Writers for every output format, behind one trait, over any seekable byte sink. Writing a
 //! file whole or not at all (a temporary file renamed into place) is the caller's job.
 
-use std::io::{BufWriter, Seek, Write};
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{io_err, EventError, Result};
-use crate::{Aedat4Writer, Compression, EventBatch};
+use crate::{Aedat4Writer, Compression, EventBatch, Sink};
 
 /// A sink for event batches.
 pub trait EventWriter {
@@ -14,10 +14,6 @@ pub trait EventWriter {
     /// Completes the file and flushes it; returns the number of events written.
     fn finish(self: Box<Self>) -> Result<u64>;
 }
-
-/// Where a writer's bytes go: a file, a temporary file, a `Cursor<Vec<u8>>`.
-pub trait Sink: Write + Seek + Send {}
-impl<T: Write + Seek + Send> Sink for T {}
 
 /// Output formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -10,8 +10,8 @@ use rayon::prelude::*;
 use super::flatbuf::Builder;
 use super::{Compression, EVENT_SIZE, MAGIC};
 use crate::error::{io_err, Result};
-use crate::writers::Sink;
 use crate::EventBatch;
+use crate::Sink;
 
 /// Events per packet, as the DV software writes them.
 pub const DEFAULT_PACKET_EVENTS: usize = 10_000;
