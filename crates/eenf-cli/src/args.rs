@@ -9,7 +9,7 @@ use anyhow::{bail, Context, Result};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use eenf::extract::ExtractOptions;
 use eenf::simulation::{EnfSource, Recipe};
-use eenf_core::Nominal;
+use eenf_core::{defaults, Nominal};
 use eenf_dsp::{EnfParams, HarmonicSelection, PeakMethod, SamplingMethod};
 use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;
@@ -75,10 +75,10 @@ pub struct TrackerArgs {
     #[arg(long, value_parser = number_in(0.01, 3600.0))]
     pub window: Option<f64>,
     /// STFT step, s (one estimate per step).
-    #[arg(long, default_value_t = 1.0, value_parser = number_in(0.001, 3600.0))]
+    #[arg(long, default_value_t = defaults::STEP_S, value_parser = number_in(0.001, 3600.0))]
     pub step: f64,
     /// Half width of the search band (and band-pass) around each line, Hz.
-    #[arg(long, default_value_t = 2.0, value_parser = number_in(0.01, 20.0))]
+    #[arg(long, default_value_t = defaults::HALF_BAND_HZ, value_parser = number_in(0.01, 20.0))]
     pub half_band: f64,
 }
 
@@ -102,19 +102,19 @@ pub struct MethodArgs {
     #[arg(long, value_parser = clap::value_parser!(i64).range(10..=1_000_000))]
     pub dt_us: Option<i64>,
     /// Number of flicker harmonics M (bands at 2m·f0, m = 1..M; those above Nyquist skipped).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=16))]
+    #[arg(long, default_value_t = defaults::HARMONICS as u32, value_parser = clap::value_parser!(u32).range(1..=16))]
     pub harmonics: u32,
     /// Butterworth order of the band-pass prototype.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
+    #[arg(long, default_value_t = defaults::FILTER_ORDER as u32, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub filter_order: u32,
     /// Running-median length of the outlier correction (0 or 1 disables it).
-    #[arg(long, default_value_t = 21, value_parser = count_in(0, 10_001))]
+    #[arg(long, default_value_t = defaults::MEDIAN_LEN, value_parser = count_in(0, 10_001))]
     pub median_len: usize,
     /// Outlier threshold on the 2f0 scale, Hz.
-    #[arg(long, default_value_t = 0.02, value_parser = number_in(0.0, 10.0))]
+    #[arg(long, default_value_t = defaults::MEDIAN_THRESHOLD_HZ, value_parser = number_in(0.0, 10.0))]
     pub median_threshold: f64,
     /// Harmonic-selection segment length, in estimates.
-    #[arg(long, default_value_t = 10, value_parser = count_in(1, 100_000))]
+    #[arg(long, default_value_t = defaults::SEGMENT_LEN, value_parser = count_in(1, 100_000))]
     pub segment: usize,
     /// Harmonic-selection rule: consensus (the smoothest among harmonics that agree with
     /// another one, within --agree-hz), smoothest (the paper: the smoothest harmonic trace per
@@ -438,7 +438,7 @@ pub struct VideoMethodArgs {
     #[arg(long, default_value = "exact", value_parser = one_of::<PeakMethod>(&PeakMethod::NAMES))]
     pub peak: PeakMethod,
     /// STFT window, s.
-    #[arg(long, default_value_t = 16.0, value_parser = number_in(0.01, 3600.0))]
+    #[arg(long, default_value_t = defaults::WINDOW_S, value_parser = number_in(0.01, 3600.0))]
     pub window: f64,
 }
 

@@ -41,18 +41,19 @@ pub struct EnfParams {
 
 impl Default for EnfParams {
     fn default() -> Self {
+        use eenf_core::defaults as d;
         EnfParams {
             nominal_hz: 50.0,
-            harmonics: 4,
-            half_band_hz: 2.0,
-            filter_order: 4,
-            window_s: 16.0,
-            step_s: 1.0,
+            harmonics: d::HARMONICS,
+            half_band_hz: d::HALF_BAND_HZ,
+            filter_order: d::FILTER_ORDER,
+            window_s: d::WINDOW_S,
+            step_s: d::STEP_S,
             peak: PeakMethod::Exact,
-            paper_bin_hz: 0.005,
-            median_len: 21,
-            median_threshold_hz: 0.02,
-            segment_len: 10,
+            paper_bin_hz: d::PAPER_BIN_HZ,
+            median_len: d::MEDIAN_LEN,
+            median_threshold_hz: d::MEDIAN_THRESHOLD_HZ,
+            segment_len: d::SEGMENT_LEN,
             selection: HarmonicSelection::Consensus(HarmonicSelection::DEFAULT_AGREE_HZ),
         }
     }
