@@ -390,13 +390,13 @@ pub struct AudioArgs {
     /// above its noise, band by band, the selection rule picking per segment); 1 tracks f0
     /// alone (the method's reference tracker); N tracks f0 … N·f0.
     #[arg(long, default_value = "auto")]
-    pub harmonics: eenf::reference::MainsLines,
+    pub harmonics: eenf::mains::MainsLines,
 }
 
 impl AudioArgs {
     /// How the hum is traced: these lines, and the tracker's `--window` if one was given.
-    pub fn hum(&self, tracker: &TrackerArgs) -> eenf::reference::HumOptions {
-        eenf::reference::HumOptions {
+    pub fn hum(&self, tracker: &TrackerArgs) -> eenf::mains::HumOptions {
+        eenf::mains::HumOptions {
             lines: self.harmonics,
             window_s: tracker.window,
         }
@@ -657,8 +657,8 @@ pub struct MatchArgs {
 
 impl MatchArgs {
     /// What the search asks for.
-    pub fn query(&self) -> eenf::reference::MatchQuery {
-        eenf::reference::MatchQuery {
+    pub fn query(&self) -> eenf::locate::MatchQuery {
+        eenf::locate::MatchQuery {
             top: self.top,
             score: self.score,
             verify: self.verify.clone(),

@@ -196,6 +196,42 @@ fn refdb_and_match_locate_a_clip() {
     let info = eenf(&["refdb", "info", "store"], d);
     assert!(info.contains("from        2022-08-17T08:00:00Z"), "{info}");
     assert!(info.contains("100.0 % covered"), "{info}");
+    // the folder of hourly WAVs as one input gives the same store, values and checksum alike
+    std::fs::create_dir(d.join("hours")).unwrap();
+    for h in ["16", "17"] {
+        let name = format!("2022_08_17_Wed_{h}_00_00.wav");
+        std::fs::copy(d.join(&name), d.join("hours").join(&name)).unwrap();
+    }
+    eenf(
+        &["-q", "refdb", "build", "again", "hours", "--tz", "+08:00"],
+        d,
+    );
+    assert_eq!(eenf(&["refdb", "info", "again"], d), info);
+    // a store is searched by match, not taken by compare or added to another store
+    std::fs::write(
+        d.join("est.csv"),
+        "time_s,enf_hz\n0,50.01\n1,50.02\n2,50.01\n",
+    )
+    .unwrap();
+    for args in [
+        &["compare", "est.csv", "store"][..],
+        &["refdb", "build", "third", "store"][..],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_eenf"))
+            .args(args)
+            .current_dir(d)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains("a reference store"),
+            "{args:?}: {err}"
+        );
+    }
+    assert!(
+        !d.join("third").exists(),
+        "a refused build leaves no store behind"
+    );
     // a 5-minute clip of the 17:xx reference with a little estimation noise
     eenf(
         &[

@@ -8,9 +8,9 @@ use std::sync::Arc;
 
 use eenf::audio::{AudioOptions, Channel, Sound};
 use eenf::extract::{extract, ExtractOptions};
+use eenf::mains::{sound_trace, HumOptions, MainsLines};
 use eenf::progress::Progress;
 use eenf::recording::Recording;
-use eenf::reference::{sound_trace, HumOptions, MainsLines};
 use eenf_events::EventBatch;
 
 fn same(a: &[f64], b: &[f64]) -> bool {

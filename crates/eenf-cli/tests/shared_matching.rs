@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use eenf::reference::reference_file;
+use eenf::mains::reference_file;
 use eenf_core::Nominal;
 use eenf_dsp::matching::{match_trace, MatchOptions, DEFAULT_ALPHA};
 use eenf_dsp::EnfParams;

@@ -469,7 +469,7 @@ fn reference(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<PyTra
     let (audio, tracker) = parse::<ReferenceArgs>("reference", argv)?.split();
     let params = tracker.params().map_err(py_err)?;
     traced(py.detach(|| {
-        eenf::reference::sound_trace(
+        eenf::mains::sound_trace(
             &Sound::File(&path),
             &audio.options(),
             &audio.hum(&tracker),
@@ -503,7 +503,7 @@ fn reference_samples(
             channels,
             fs,
         };
-        eenf::reference::sound_trace(
+        eenf::mains::sound_trace(
             &sound,
             &audio.options(),
             &audio.hum(&tracker),
@@ -609,13 +609,10 @@ fn match_trace(
     let m: MatchArgs = parse("match", argv)?;
     let t = trace.0.clone();
     py.detach(|| {
-        let nominal = eenf::reference::match_grid(&t, &name)?;
         let tz = m.tz.as_deref().map(eenf::time::tz_offset).transpose()?;
-        let refs =
-            eenf::reference::ReferenceSeries::load(&reference, nominal, tz, &Progress::hidden())?;
         let query = m.query();
-        let report = eenf::reference::match_trace_in(&t, &name, &refs, &query)?;
-        Ok(report.to_json(&name, &refs, query.alpha).to_string())
+        let located = eenf::locate::locate(&t, &name, &reference, tz, &query, &Progress::hidden())?;
+        Ok(located.to_json(&name, query.alpha).to_string())
     })
     .map_err(py_err)
 }

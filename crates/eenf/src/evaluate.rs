@@ -8,11 +8,11 @@ use anyhow::{bail, Context, Result};
 use eenf_dsp::{agreement, Agreement, EnfParams};
 
 use crate::dataset::{recording_start, reference_hour};
+use crate::mains::reference_file;
 use crate::output::folder_of;
-use crate::reference::{reference_file, reference_for_recording};
+use crate::reference::{reference_for_recording, ReferenceSource};
 use crate::time::LocalTime;
 use crate::trace::Trace;
-use crate::wav::is_wav;
 use eenf_core::Nominal;
 
 /// Where a recording's reference ENF comes from.
@@ -50,7 +50,14 @@ impl Reference {
         offset_s: f64,
         index_step_s: f64,
     ) -> Result<(Reference, f64)> {
-        if path.is_dir() {
+        let source = ReferenceSource::open(path)?;
+        if let ReferenceSource::Store(dir) = &source {
+            bail!(
+                "{}: a reference store: `match` searches stores; compare takes a trace, a WAV or a folder of hourly WAVs",
+                dir.display()
+            );
+        }
+        if let ReferenceSource::HourlyFolder(_) = source {
             let start = recording_start(recording).with_context(|| {
                 format!(
                     "{}: cannot tell when the recording started: its name has no dvSave-YYYY_MM_DD_HH_MM_SS",
@@ -65,7 +72,7 @@ impl Reference {
                 offset_s,
             ));
         }
-        if !is_wav(path) {
+        if let ReferenceSource::Trace(_) = source {
             let reference = Reference::Trace {
                 path: path.to_path_buf(),
                 index_step_s,

@@ -7,9 +7,10 @@
 //! warnings). The data path:
 //!
 //! - [`extract`]: an event recording → its polarity sequence → a [`trace::Trace`] (E-ENF);
-//!   [`video`]: a video → a `Trace` (V-ENF); [`reference`]: a mains recording → a `Trace`.
+//!   [`video`]: a video → a `Trace` (V-ENF); [`mains`]: a mains or audio recording → a `Trace`.
+//! - [`reference`]: where a reference comes from ([`reference::ReferenceSource`]), the long
+//!   series [`locate`] searches (`match`), and the store [`refdb`] keeps them in.
 //! - [`evaluate`]: a `Trace` against its reference → an `Agreement` (CC, MAE, RMSE, max).
-//! - [`refdb`] and [`reference::ReferenceSeries`]: long references that `match` searches.
 //! - [`bench`]: every method over a dataset, Table 2 and its reports; [`simulation`] and
 //!   [`dataset`]: simulated recordings and datasets with their truth.
 //!
@@ -26,6 +27,8 @@ pub mod evaluate;
 pub mod extract;
 pub mod flicker_map;
 pub mod inspect;
+pub mod locate;
+pub mod mains;
 pub mod output;
 pub mod progress;
 pub mod recording;

@@ -1,260 +1,64 @@
-//! Mains references: the ENF of a mains (or audio) recording, the reference of one recording
-//! from a dataset's hourly WAVs, and the long reference series that `match` searches.
+//! References: where a reference comes from ([`ReferenceSource`]: a store, a folder of hourly
+//! mains WAVs, one WAV, a trace file), the reference of one recording from a dataset's hourly
+//! WAVs, and the long series that `match` searches.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use eenf_dsp::hum::{MAX_HUM_HARMONIC, MIN_CLIP_S};
-use eenf_dsp::matching::{
-    match_trace, resample, Candidate, MatchError, MatchOptions, MatchResult, ScaledSeries, Score,
-    Verification,
-};
-use eenf_dsp::{
-    check_holds_line, choose_window, enf_from_hum_lines, plausibility, reference_enf, search_hum,
-    EnfParams,
-};
+use eenf_dsp::matching::{match_trace, MatchError, MatchOptions, MatchResult, ScaledSeries};
+use eenf_dsp::{reference_enf, EnfParams};
 
 use crate::audio::read_wav;
-use crate::audio::{AudioOptions, Sound};
 use crate::dataset::hourly_references;
+use crate::mains::{mains_nominal, reference_file};
 use crate::progress::Progress;
-use crate::refdb::{RefSeries, GAP};
+use crate::refdb::{check_grid_name, RefSeries, StoreLock, GAP};
 use crate::time::LocalTime;
-use crate::trace::{AudioProvenance, HumReport, MainsProvenance, Provenance, Trace};
+use crate::trace::Trace;
+use crate::wav::is_wav;
 use eenf_core::Nominal;
-use eenf_core::Signal;
 
-/// Decides or checks the nominal frequency of a mains signal: the line detector on f0 alone.
-pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<f64> {
-    let err = |e: eenf_dsp::DspError| anyhow::anyhow!("{}: {e}", path.display());
-    let grids = grids_of(nominal);
-    let top = grids.iter().fold(0.0f64, |a, &b| a.max(b));
-    if sig.fs < 2.0 * (top + 8.0) {
-        bail!(
-            "{}: sample rate {} Hz is too low to carry a {top} Hz mains tone",
-            path.display(),
-            sig.fs
-        );
-    }
-    let search = search_hum(&sig.samples, sig.fs, 1.0, grids, 1).ok_or_else(|| {
-        err(eenf_dsp::DspError::TooShort {
-            duration_s: sig.samples.len() as f64 / sig.fs,
-            window_s: 1.0,
-        })
-    })?;
-    Ok(search.verdict().map_err(err)?.grid_hz)
+/// Where a reference comes from, told from what is at its path: the one place that decides.
+/// `compare` takes a window of it, `match` searches it, `refdb build` adds it to a store.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ReferenceSource {
+    /// A store from `refdb build`: one long series per grid.
+    Store(PathBuf),
+    /// A folder of hourly mains WAVs named by their local start (`2022_08_17_Wed_16_00_00.wav`).
+    HourlyFolder(PathBuf),
+    /// One mains WAV.
+    Wav(PathBuf),
+    /// A trace file: eenf CSV or JSON, or an `index,value` CSV.
+    Trace(PathBuf),
 }
 
-/// The grids a `--nominal` leaves open.
-fn grids_of(nominal: Nominal) -> &'static [f64] {
-    match nominal {
-        Nominal::Auto => &[50.0, 60.0],
-        Nominal::Hz(50.0) => &[50.0],
-        Nominal::Hz(_) => &[60.0],
-    }
-}
-
-/// The reference trace of a whole mains WAV (every channel mixed, f0 alone: the method's
-/// reference tracker).
-pub fn reference_file(path: &Path, nominal: Nominal, params: &EnfParams) -> Result<Trace> {
-    let hum = HumOptions {
-        lines: MainsLines::UpTo(1),
-        window_s: Some(params.window_s),
-    };
-    audio_trace(path, &AudioOptions::default(), &hum, nominal, params)
-}
-
-/// Which mains lines a sound is traced on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum MainsLines {
-    /// Those the line detector finds standing, up to [`MAX_HUM_HARMONIC`]·f0: f0 alone (the
-    /// method's reference tracker) when it carries the ENF clearly, else every harmonic that
-    /// stands, band by band, combined per segment by the selection rule.
-    #[default]
-    Auto,
-    /// f0 … N·f0 (1: f0 alone, the reference tracker).
-    UpTo(usize),
-}
-
-impl std::str::FromStr for MainsLines {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "auto" => Ok(MainsLines::Auto),
-            _ => match s.parse::<usize>() {
-                Ok(n) if (1..=MAX_HUM_HARMONIC).contains(&n) => Ok(MainsLines::UpTo(n)),
-                _ => Err(format!(
-                    "{s:?}: expected auto or a number of lines from 1 to {MAX_HUM_HARMONIC}"
-                )),
-            },
-        }
-    }
-}
-
-impl std::fmt::Display for MainsLines {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            MainsLines::Auto => f.write_str("auto"),
-            MainsLines::UpTo(n) => write!(f, "{n}"),
-        }
-    }
-}
-
-/// How a sound's hum is traced: its lines, and the window (`None`: chosen from the recording
-/// and its hum, see [`eenf_dsp::choose_window`]; the default of `params` is the start).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct HumOptions {
-    /// The lines tracked.
-    pub lines: MainsLines,
-    /// The analysis window, s, when set.
-    pub window_s: Option<f64>,
-}
-
-/// f0 alone carries the ENF when its line is the strongest and stands this high (dB over its
-/// floor): mains recordings, where harmonics add nothing but distortion.
-const F0_ALONE_DB: f64 = 30.0;
-
-/// The ENF of a recording's sound (a mains recording, a voice recorder, a video's soundtrack):
-/// read as `audio` says, decimated to what its lines need, and tracked as `hum` says.
-pub fn audio_trace(
-    path: &Path,
-    audio: &AudioOptions,
-    hum: &HumOptions,
-    nominal: Nominal,
-    params: &EnfParams,
-) -> Result<Trace> {
-    sound_trace(&Sound::File(path), audio, hum, nominal, params)
-}
-
-/// The ENF of a sound, from a file or from samples in memory (see [`audio_trace`]): the line
-/// detector finds the grid and the harmonics that stand, a window is chosen for the clip and
-/// its hum, the trace must hold its line, and it is checked against what grids do (offset,
-/// steadiness).
-pub fn sound_trace(
-    sound: &Sound,
-    audio: &AudioOptions,
-    hum: &HumOptions,
-    nominal: Nominal,
-    params: &EnfParams,
-) -> Result<Trace> {
-    let path = sound.name();
-    let err = |e: eenf_dsp::DspError| anyhow::anyhow!("{}: {e}", path.display());
-    let grids = grids_of(nominal);
-    let top_grid = grids.iter().fold(0.0f64, |a, &b| a.max(b));
-    let most = match hum.lines {
-        MainsLines::Auto => MAX_HUM_HARMONIC,
-        MainsLines::UpTo(n) => n.max(1),
-    };
-    // room for every line looked for and its floor beside it
-    let top_of = |k: usize| k as f64 * top_grid + params.half_band_hz.max(6.0) + 4.0;
-    let first_top = match hum.lines {
-        MainsLines::Auto => top_of(most),
-        // as these lines were always read (a reference's rate unchanged)
-        MainsLines::UpTo(n) => n as f64 * top_grid + params.half_band_hz + 4.0,
-    };
-    let a = sound.read(&AudioOptions {
-        top_hz: Some(first_top),
-        ..*audio
-    })?;
-    let provenance_audio = |fs: f64| AudioProvenance {
-        decoder: a.decoder.to_string(),
-        source_rate_hz: a.source_rate,
-        rate_hz: fs,
-        channels: a.channels,
-        channel: audio.channel.to_string(),
-        frames: a.frames,
-    };
-    let duration_s = a.signal.samples.len() as f64 / a.signal.fs;
-    if let MainsLines::UpTo(1) = hum.lines {
-        // the method's reference tracker: f0 alone, unfiltered
-        let f0 = mains_nominal(&a.signal, nominal, path)?;
-        let p = EnfParams {
-            nominal_hz: f0,
-            window_s: hum.window_s.unwrap_or(params.window_s),
-            ..params.clone()
-        };
-        let enf = reference_enf(&a.signal.samples, a.signal.fs, &p).map_err(err)?;
-        let mut t = Trace::from_mains(path, f0, &p, enf);
-        if let Some(Provenance::Mains(m)) = t.provenance.as_mut() {
-            // a plain mains WAV at its own rate keeps the bare provenance it always had
-            if a.source_rate != a.signal.fs || a.channels > 1 || a.decoder != "symphonia" {
-                m.audio = Some(provenance_audio(a.signal.fs));
+impl ReferenceSource {
+    /// What `path` holds: a folder with grid manifests is a store, any other folder a folder of
+    /// hourly WAVs, a RIFF/WAVE file a WAV, anything else a trace file.
+    pub fn open(path: &Path) -> Result<Self> {
+        let p = path.to_path_buf();
+        Ok(if path.is_dir() {
+            if RefSeries::grids(path)?.is_empty() {
+                ReferenceSource::HourlyFolder(p)
+            } else {
+                ReferenceSource::Store(p)
             }
+        } else if is_wav(path) {
+            ReferenceSource::Wav(p)
+        } else {
+            ReferenceSource::Trace(p)
+        })
+    }
+
+    /// Its path.
+    pub fn path(&self) -> &Path {
+        match self {
+            ReferenceSource::Store(p)
+            | ReferenceSource::HourlyFolder(p)
+            | ReferenceSource::Wav(p)
+            | ReferenceSource::Trace(p) => p,
         }
-        t.warnings.extend(a.warning.clone());
-        return Ok(t);
     }
-    if duration_s < MIN_CLIP_S {
-        return Err(err(eenf_dsp::DspError::TooShort {
-            duration_s,
-            window_s: MIN_CLIP_S,
-        }));
-    }
-    let search = search_hum(&a.signal.samples, a.signal.fs, 1.0, grids, most).ok_or_else(|| {
-        anyhow::anyhow!(
-            "{}: sample rate {} Hz is too low to carry a mains line with its noise floor beside it",
-            path.display(),
-            a.signal.fs
-        )
-    })?;
-    let verdict = search.verdict().map_err(err)?;
-    let f0 = verdict.grid_hz;
-    let (window_s, window_note) = match hum.window_s {
-        Some(w) => (w, None),
-        None => choose_window(
-            duration_s,
-            params.window_s,
-            verdict.strongest.db,
-            search.segment_s,
-        )
-        .map_err(err)?,
-    };
-    let f0_alone = verdict.strongest.harmonic == 1 && verdict.strongest.db >= F0_ALONE_DB;
-    let carriers: Vec<usize> = if f0_alone {
-        vec![1]
-    } else {
-        verdict.carriers.clone()
-    };
-    let highest = carriers.iter().copied().max().unwrap_or(1);
-    let sig = a.narrowed(top_of(highest));
-    let p = EnfParams {
-        nominal_hz: f0,
-        harmonics: highest,
-        window_s,
-        ..params.clone()
-    };
-    let edge = (window_s / 2.0 / p.step_s).ceil() as usize;
-    let mut trace = if f0_alone {
-        let enf = reference_enf(&sig.samples, sig.fs, &p).map_err(err)?;
-        Trace::from_mains(path, f0, &p, enf)
-    } else {
-        let estimates = enf_from_hum_lines(&sig.samples, sig.fs, &p, &carriers).map_err(err)?;
-        Trace::from_mains_lines(
-            path,
-            f0,
-            &estimates,
-            MainsProvenance {
-                peak: p.peak,
-                window_s,
-                mains_lines: carriers.len(),
-                audio: None,
-                hum: None,
-            },
-        )
-    };
-    check_holds_line(&trace.enf_hz, p.step_s, window_s).map_err(err)?;
-    let plausibility = plausibility(&trace.enf_hz, p.step_s, f0, edge);
-    if let Some(Provenance::Mains(m)) = trace.provenance.as_mut() {
-        m.audio = Some(provenance_audio(sig.fs));
-        m.hum = Some(HumReport {
-            search,
-            carriers,
-            window_note,
-            plausibility,
-        });
-    }
-    trace.warnings.extend(a.warning.clone());
-    Ok(trace)
 }
 
 /// The reference trace for a recording that starts at `start` (local time from its name) and
@@ -455,10 +259,14 @@ impl ReferenceSeries {
         tz_s: Option<f64>,
         progress: &Progress,
     ) -> Result<Vec<Self>> {
-        if path.is_dir() {
+        let source = ReferenceSource::open(path)?;
+        if matches!(
+            source,
+            ReferenceSource::Store(_) | ReferenceSource::HourlyFolder(_)
+        ) {
             let grids = RefSeries::grids(path)?;
-            if !grids.is_empty() {
-                let _lock = crate::refdb::StoreLock::shared(path)?;
+            if let ReferenceSource::Store(_) = source {
+                let _lock = StoreLock::shared(path)?;
                 let mut out = Vec::new();
                 for g in grids {
                     let meta = RefSeries::load_meta(path, &g)?;
@@ -507,7 +315,7 @@ impl ReferenceSeries {
                 values: SeriesValues::Hz(series.hz()),
             }]);
         }
-        let (start, absolute, step, hz) = if crate::wav::is_wav(path) {
+        let (start, absolute, step, hz) = if let ReferenceSource::Wav(_) = source {
             let trace = reference_file(path, Nominal::Hz(nominal), &EnfParams::default())?;
             if crate::dataset::reference_hour(path).is_some() {
                 (wav_start(path, tz_s)?, true, 1.0, trace.enf_hz)
@@ -534,154 +342,148 @@ impl ReferenceSeries {
     }
 }
 
-/// What `match` asks of the references.
+/// What `refdb build` adds to a store, and how.
 #[derive(Debug, Clone)]
-pub struct MatchQuery {
-    /// Candidates to list.
-    pub top: usize,
-    /// What ranks offsets.
-    pub score: Score,
-    /// A claimed start time to check (an absolute time, or seconds for a relative reference).
-    pub verify: Option<String>,
-    /// A candidate is a match when its p-value is below this.
-    pub alpha: f64,
+pub struct StoreBuild {
+    /// Inputs: hourly mains WAVs, folders of them, or trace CSVs; a CSV may carry its start as
+    /// `FILE@2022-08-01T00:00:00Z`.
+    pub inputs: Vec<String>,
+    /// Grid name (default: `grid50` or `grid60` from the data).
+    pub grid: Option<String>,
+    /// Zone of the local times in WAV names, seconds east of UTC.
+    pub tz_s: Option<f64>,
+    /// Start of the first trace CSV without its own, Unix seconds; each next one continues
+    /// where the previous ended.
+    pub start: Option<f64>,
+    /// Seconds between the values of `index,value` CSVs.
+    pub index_step_s: Option<f64>,
+    /// Wait for another build that holds the store (else fail at once).
+    pub wait: bool,
 }
 
-/// One place where the trace fits.
-#[derive(Debug, Clone)]
-pub struct Placement {
-    /// The reference series (index into the searched list).
-    pub series: usize,
-    /// The candidate: offset in the series' steps, agreement, p-value.
-    pub candidate: Candidate,
+/// A grid a build changed: its name and how many values it now holds.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GridBuilt {
+    /// The grid's name.
+    pub grid: String,
+    /// Values it holds after the build.
+    pub values: usize,
 }
 
-/// How the claimed time of [`MatchQuery::verify`] fits.
-#[derive(Debug, Clone)]
-pub struct Verified {
-    /// The reference series holding the claimed time.
-    pub series: usize,
-    /// Its score, rank and significance.
-    pub verification: Verification,
-}
-
-/// The outcome of `match`: the best places over every series, best first.
-#[derive(Debug, Clone)]
-pub struct MatchReport {
-    /// The grid searched, Hz.
-    pub nominal_hz: f64,
-    /// The best candidates over all series (lowest p-value, then highest CC).
-    pub placements: Vec<Placement>,
-    /// The claimed time's fit, when one was given and falls inside a series.
-    pub verified: Option<Verified>,
-    /// Seconds the search took.
-    pub seconds: f64,
-}
-
-/// Where `trace` (named `name`) fits in the series `refs`, as `query` asks.
-pub fn match_trace_in(
-    trace: &Trace,
-    name: &Path,
-    refs: &[ReferenceSeries],
-    query: &MatchQuery,
-) -> Result<MatchReport> {
-    let nominal_hz = match_grid(trace, name)?;
-    let started = std::time::Instant::now();
-    let mut placements = Vec::new();
-    let mut verified = None;
-    for (i, r) in refs.iter().enumerate() {
-        let q = resample(&trace.enf_hz, trace.step_s, r.step);
-        let verify = match &query.verify {
-            Some(t) => {
-                let at = if r.absolute {
-                    crate::time::parse_time(t)?
-                } else {
-                    t.parse::<f64>()
-                        .context("--verify with a relative reference takes seconds")?
-                };
-                let k = ((at - r.start) / r.step).round();
-                (k >= 0.0).then_some(k as usize)
+/// Adds the references of `build` to the store at `store` (created when missing): one series
+/// per grid, new values replace old, gaps stay gaps. The whole read-merge-write holds the
+/// store's lock; `on_wait` is called when another build holds it and this one waits.
+pub fn build_store(
+    store: &Path,
+    build: &StoreBuild,
+    progress: &Progress,
+    on_wait: impl FnOnce(),
+) -> Result<Vec<GridBuilt>> {
+    if let Some(g) = &build.grid {
+        check_grid_name(g)?;
+    }
+    // each input as the files it stands for: a folder of hourly WAVs gives its hours in order
+    let mut files: Vec<(PathBuf, Option<f64>)> = Vec::new();
+    for input in &build.inputs {
+        let (path, at) = match input.rsplit_once('@') {
+            Some((p, t)) if !Path::new(input).exists() => {
+                (PathBuf::from(p), Some(crate::time::parse_time(t)?))
             }
-            None => None,
+            _ => (PathBuf::from(input), None),
         };
-        let opts = MatchOptions {
-            top: query.top,
-            score: query.score,
-            verify,
-            ..MatchOptions::default()
-        };
-        let res = r
-            .values
-            .search(&q, &opts)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", name.display()))?;
-        if let Some(v) = res.verification {
-            verified = Some(Verified {
-                series: i,
-                verification: v,
-            });
+        match ReferenceSource::open(&path)? {
+            ReferenceSource::HourlyFolder(dir) => {
+                files.extend(hourly_references(&dir)?.into_iter().map(|(_, f)| (f, None)))
+            }
+            ReferenceSource::Store(dir) => bail!(
+                "{}: a reference store; its series cannot be added to another store",
+                dir.display()
+            ),
+            _ => files.push((path, at)),
         }
-        placements.extend(res.candidates.into_iter().map(|candidate| Placement {
-            series: i,
-            candidate,
-        }));
     }
-    placements.sort_by(|x, y| {
-        let (x, y) = (&x.candidate, &y.candidate);
-        x.p_value
-            .total_cmp(&y.p_value)
-            .then(y.agreement.cc.total_cmp(&x.agreement.cc))
-    });
-    placements.truncate(query.top);
-    Ok(MatchReport {
-        nominal_hz,
-        placements,
-        verified,
-        seconds: started.elapsed().as_secs_f64(),
-    })
+    // the whole read-merge-write under the store's lock: a second build waits for this one
+    let _lock = StoreLock::exclusive(store, build.wait, on_wait)?;
+    let bar = progress.steps(files.len() as u64, "adding references");
+    let mut series: Vec<RefSeries> = Vec::new();
+    let mut next_start = build.start;
+    for (path, at) in &files {
+        let (start, trace) = if is_wav(path) {
+            let trace = reference_file(path, Nominal::Auto, &EnfParams::default())?;
+            (at.unwrap_or(wav_start(path, build.tz_s)?), trace)
+        } else {
+            let trace = read_series(path, build.index_step_s)?;
+            let start = at.or(next_start).with_context(|| {
+                format!(
+                    "{}: give its start as FILE@TIME or with --start",
+                    path.display()
+                )
+            })?;
+            (start, trace)
+        };
+        let (step, values) = (trace.step_s, &trace.enf_hz);
+        next_start = Some(start + values.len() as f64 * step);
+        let f0 = nominal_of(&trace, path)?;
+        let grid = build
+            .grid
+            .clone()
+            .unwrap_or_else(|| format!("grid{}", f0 as u32));
+        let idx = match series.iter().position(|s| s.meta.grid == grid) {
+            Some(i) => i,
+            None => {
+                let s = if store.join(format!("{grid}.json")).exists() {
+                    RefSeries::load(store, &grid)?
+                } else {
+                    RefSeries::new(&grid, f0, step, start)
+                };
+                series.push(s);
+                series.len() - 1
+            }
+        };
+        let s = &mut series[idx];
+        if s.meta.nominal_hz != f0 {
+            bail!(
+                "{}: a {f0} Hz trace cannot go into grid {grid:?}, which is {} Hz (50 and 60 Hz are never mixed)",
+                path.display(),
+                s.meta.nominal_hz
+            );
+        }
+        s.merge(start, step, values)?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let mut built = Vec::new();
+    for s in &mut series {
+        s.save(store)?;
+        RefSeries::remove_orphans(store, &s.meta.grid)?;
+        built.push(GridBuilt {
+            grid: s.meta.grid.clone(),
+            values: s.values.len(),
+        });
+    }
+    Ok(built)
 }
 
-/// The grid of a trace to be matched: it must hold two values, rising times, and a mean on a
-/// 50 or 60 Hz grid.
-pub fn match_grid(trace: &Trace, name: &Path) -> Result<f64> {
-    if trace.enf_hz.len() < 2 {
-        bail!("{}: too short to match", name.display());
+/// A trace CSV (`time_s,enf_hz`) or, with `index_step_s`, an `index,value` CSV.
+fn read_series(path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
+    let text = crate::trace::read_text(path)?;
+    let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
+    if index_step_s.is_none() && !header.contains("time_s") {
+        bail!("{}: an index CSV needs --step", path.display());
     }
-    if trace.step_s <= 0.0 {
-        bail!("{}: times must increase", name.display());
+    Trace::parse(&text, path, index_step_s)
+}
+
+/// The grid of a trace's values, 50 or 60 Hz.
+fn nominal_of(trace: &Trace, path: &Path) -> Result<f64> {
+    if trace.finite().next().is_none() {
+        bail!("{}: no values", path.display());
     }
     trace.grid_hz().with_context(|| {
         format!(
             "{}: mean {:.3} Hz is neither a 50 nor a 60 Hz grid",
-            name.display(),
+            path.display(),
             trace.mean_hz()
         )
     })
-}
-
-impl MatchReport {
-    /// The report as `eenf match --json` prints it.
-    pub fn to_json(&self, trace: &Path, refs: &[ReferenceSeries], alpha: f64) -> serde_json::Value {
-        let cands: Vec<_> = self
-            .placements
-            .iter()
-            .map(|p| {
-                let (r, c) = (&refs[p.series], &p.candidate);
-                serde_json::json!({"reference": r.name, "start": r.time_label(c.offset),
-                    "start_s": r.start + c.offset * r.step, "offset_steps": c.offset,
-                    "cc": c.agreement.cc, "mae_hz": c.agreement.mae_hz,
-                    "rmse_hz": c.agreement.rmse_hz, "overlap": c.agreement.n,
-                    "p_value": c.p_value, "match": c.p_value < alpha})
-            })
-            .collect();
-        serde_json::json!({
-            "trace": trace, "nominal_hz": self.nominal_hz, "alpha": alpha, "seconds": self.seconds,
-            "candidates": cands,
-            "verify": self.verified.as_ref().map(|v| {
-                let (r, v) = (&refs[v.series], &v.verification);
-                serde_json::json!({
-                "time": r.time_label(v.offset as f64), "cc": v.agreement.cc,
-                "mae_hz": v.agreement.mae_hz, "rmse_hz": v.agreement.rmse_hz, "rank": v.rank, "p_value": v.p_value,
-                "best_fit": v.rank == 1, "consistent": v.rank == 1 && v.p_value < alpha})}),
-        })
-    }
 }

@@ -10,12 +10,13 @@ use eenf_sim::{simulate, CameraConfig, MainsPhase, SimConfig, SimStats, Syntheti
 
 use crate::audio::read_wav;
 use crate::dataset::{hourly_references, reference_name};
+use crate::mains::mains_nominal;
 use crate::output::{sibling, write_atomic, write_events};
 use crate::progress::Progress;
-use crate::reference::mains_nominal;
+use crate::reference::ReferenceSource;
 use crate::time::{offset_of, parse_time, LocalTime};
 use crate::trace::Trace;
-use crate::wav::{is_wav, write_wav};
+use crate::wav::write_wav;
 use eenf_core::Nominal;
 
 /// Sampling rate of synthesized mains references (the dataset's).
@@ -554,10 +555,13 @@ pub fn recipe_timeline(r: &Recipe) -> Result<(EnfTimeline, f64, f64)> {
             }
             let (start, tz) = local_start(&r.start, Some(path), *offset_s)?;
             let t0 = start - offset_s;
-            let t = if is_wav(path) {
-                EnfTimeline::wav(path, t0)?
-            } else {
-                EnfTimeline::trace(path, *index_step_s, t0)?
+            let t = match ReferenceSource::open(path)? {
+                ReferenceSource::Wav(_) => EnfTimeline::wav(path, t0)?,
+                ReferenceSource::Trace(_) => EnfTimeline::trace(path, *index_step_s, t0)?,
+                _ => bail!(
+                    "{}: a folder, where a mains WAV or a trace file is needed",
+                    path.display()
+                ),
             };
             Ok((t, start, tz))
         }

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use eenf::audio::{AudioOptions, Sound};
-use eenf::reference::{sound_trace, HumOptions, MainsLines};
+use eenf::mains::{sound_trace, HumOptions, MainsLines};
 use eenf::trace::{Provenance, Trace};
 use eenf_core::Nominal;
 use eenf_dsp::EnfParams;

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use eenf::audio::read_wav;
 use eenf::audio::{AudioOptions, Sound};
-use eenf::reference::{audio_trace, reference_file, sound_trace, HumOptions};
+use eenf::mains::{audio_trace, reference_file, sound_trace, HumOptions};
 use eenf::trace::{Provenance, Trace};
 use eenf_core::Nominal;
 use eenf_dsp::{agreement, search_hum, EnfParams};

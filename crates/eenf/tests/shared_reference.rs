@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use eenf::reference::reference_file;
+use eenf::mains::reference_file;
 use eenf_core::Nominal;
 use eenf_dsp::{EnfParams, PeakMethod};
 

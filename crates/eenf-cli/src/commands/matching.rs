@@ -4,8 +4,9 @@ use std::path::PathBuf;
 
 use crate::plot::plot_comparison;
 use anyhow::Result;
+use eenf::locate::locate;
 use eenf::progress::Progress;
-use eenf::reference::{match_grid, match_trace_in, ReferenceSeries};
+use eenf::reference::ReferenceSeries;
 use eenf::time::tz_offset;
 use eenf::trace::Trace;
 use eenf_dsp::matching::resample;
@@ -33,11 +34,11 @@ pub struct Args {
 /// Runs `eenf match`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let trace = Trace::read(&a.trace, None)?;
-    let nominal = match_grid(&trace, &a.trace)?;
     let tz = a.search.tz.as_deref().map(tz_offset).transpose()?;
-    let refs = ReferenceSeries::load(&a.reference, nominal, tz, &progress)?;
     let query = a.search.query();
-    let report = match_trace_in(&trace, &a.trace, &refs, &query)?;
+    let located = locate(&trace, &a.trace, &a.reference, tz, &query, &progress)?;
+    let (report, refs) = (&located.report, &located.references);
+    let nominal = report.nominal_hz;
     let rows: Vec<_> = report
         .placements
         .iter()
@@ -71,7 +72,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         )?;
     }
     if a.json {
-        let v = report.to_json(&a.trace, &refs, query.alpha);
+        let v = located.to_json(&a.trace, query.alpha);
         outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }

@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use eenf::mains::audio_trace;
 use eenf::progress::Progress;
-use eenf::reference::audio_trace;
 use eenf::trace::{MainsProvenance, Provenance};
 
 use crate::args::{AudioArgs, TraceOutputArgs, TrackerArgs};

@@ -1,0 +1,196 @@
+//! `match`: where a trace fits in long references, and when it was therefore recorded.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use eenf_dsp::matching::{resample, Candidate, MatchOptions, Score, Verification};
+
+use crate::progress::Progress;
+use crate::reference::ReferenceSeries;
+use crate::trace::Trace;
+
+/// What `match` asks of the references.
+#[derive(Debug, Clone)]
+pub struct MatchQuery {
+    /// Candidates to list.
+    pub top: usize,
+    /// What ranks offsets.
+    pub score: Score,
+    /// A claimed start time to check (an absolute time, or seconds for a relative reference).
+    pub verify: Option<String>,
+    /// A candidate is a match when its p-value is below this.
+    pub alpha: f64,
+}
+
+/// One place where the trace fits.
+#[derive(Debug, Clone)]
+pub struct Placement {
+    /// The reference series (index into the searched list).
+    pub series: usize,
+    /// The candidate: offset in the series' steps, agreement, p-value.
+    pub candidate: Candidate,
+}
+
+/// How the claimed time of [`MatchQuery::verify`] fits.
+#[derive(Debug, Clone)]
+pub struct Verified {
+    /// The reference series holding the claimed time.
+    pub series: usize,
+    /// Its score, rank and significance.
+    pub verification: Verification,
+}
+
+/// The outcome of `match`: the best places over every series, best first.
+#[derive(Debug, Clone)]
+pub struct MatchReport {
+    /// The grid searched, Hz.
+    pub nominal_hz: f64,
+    /// The best candidates over all series (lowest p-value, then highest CC).
+    pub placements: Vec<Placement>,
+    /// The claimed time's fit, when one was given and falls inside a series.
+    pub verified: Option<Verified>,
+    /// Seconds the search took.
+    pub seconds: f64,
+}
+
+/// A trace placed in long references: the report, and the series it was searched in (which
+/// give its candidates their names and times).
+pub struct Located {
+    /// The best places, and the claimed time's fit.
+    pub report: MatchReport,
+    /// The series searched, as [`Placement::series`] and [`Verified::series`] index them.
+    pub references: Vec<ReferenceSeries>,
+}
+
+impl Located {
+    /// The result as `eenf match --json` prints it.
+    pub fn to_json(&self, trace: &Path, alpha: f64) -> serde_json::Value {
+        self.report.to_json(trace, &self.references, alpha)
+    }
+}
+
+/// Where `trace` (named `name` in messages) fits in the references at `reference` (a store, a
+/// folder of hourly WAVs, a WAV or a trace; hourly names are local times in the zone `tz_s`
+/// seconds east of UTC), as `query` asks: the command's and the Python package's `match`.
+pub fn locate(
+    trace: &Trace,
+    name: &Path,
+    reference: &Path,
+    tz_s: Option<f64>,
+    query: &MatchQuery,
+    progress: &Progress,
+) -> Result<Located> {
+    let nominal_hz = match_grid(trace, name)?;
+    let references = ReferenceSeries::load(reference, nominal_hz, tz_s, progress)?;
+    let report = match_trace_in(trace, name, nominal_hz, &references, query)?;
+    Ok(Located { report, references })
+}
+
+/// Where `trace` (named `name`, on the `nominal_hz` grid [`match_grid`] found) fits in the
+/// series `refs`, as `query` asks.
+pub fn match_trace_in(
+    trace: &Trace,
+    name: &Path,
+    nominal_hz: f64,
+    refs: &[ReferenceSeries],
+    query: &MatchQuery,
+) -> Result<MatchReport> {
+    let started = std::time::Instant::now();
+    let mut placements = Vec::new();
+    let mut verified = None;
+    for (i, r) in refs.iter().enumerate() {
+        let q = resample(&trace.enf_hz, trace.step_s, r.step);
+        let verify = match &query.verify {
+            Some(t) => {
+                let at = if r.absolute {
+                    crate::time::parse_time(t)?
+                } else {
+                    t.parse::<f64>()
+                        .context("--verify with a relative reference takes seconds")?
+                };
+                let k = ((at - r.start) / r.step).round();
+                (k >= 0.0).then_some(k as usize)
+            }
+            None => None,
+        };
+        let opts = MatchOptions {
+            top: query.top,
+            score: query.score,
+            verify,
+            ..MatchOptions::default()
+        };
+        let res = r
+            .values
+            .search(&q, &opts)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", name.display()))?;
+        if let Some(v) = res.verification {
+            verified = Some(Verified {
+                series: i,
+                verification: v,
+            });
+        }
+        placements.extend(res.candidates.into_iter().map(|candidate| Placement {
+            series: i,
+            candidate,
+        }));
+    }
+    placements.sort_by(|x, y| {
+        let (x, y) = (&x.candidate, &y.candidate);
+        x.p_value
+            .total_cmp(&y.p_value)
+            .then(y.agreement.cc.total_cmp(&x.agreement.cc))
+    });
+    placements.truncate(query.top);
+    Ok(MatchReport {
+        nominal_hz,
+        placements,
+        verified,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// The grid of a trace to be matched: it must hold two values, rising times, and a mean on a
+/// 50 or 60 Hz grid.
+pub fn match_grid(trace: &Trace, name: &Path) -> Result<f64> {
+    if trace.enf_hz.len() < 2 {
+        bail!("{}: too short to match", name.display());
+    }
+    if trace.step_s <= 0.0 {
+        bail!("{}: times must increase", name.display());
+    }
+    trace.grid_hz().with_context(|| {
+        format!(
+            "{}: mean {:.3} Hz is neither a 50 nor a 60 Hz grid",
+            name.display(),
+            trace.mean_hz()
+        )
+    })
+}
+
+impl MatchReport {
+    /// The report as `eenf match --json` prints it.
+    pub fn to_json(&self, trace: &Path, refs: &[ReferenceSeries], alpha: f64) -> serde_json::Value {
+        let cands: Vec<_> = self
+            .placements
+            .iter()
+            .map(|p| {
+                let (r, c) = (&refs[p.series], &p.candidate);
+                serde_json::json!({"reference": r.name, "start": r.time_label(c.offset),
+                    "start_s": r.start + c.offset * r.step, "offset_steps": c.offset,
+                    "cc": c.agreement.cc, "mae_hz": c.agreement.mae_hz,
+                    "rmse_hz": c.agreement.rmse_hz, "overlap": c.agreement.n,
+                    "p_value": c.p_value, "match": c.p_value < alpha})
+            })
+            .collect();
+        serde_json::json!({
+            "trace": trace, "nominal_hz": self.nominal_hz, "alpha": alpha, "seconds": self.seconds,
+            "candidates": cands,
+            "verify": self.verified.as_ref().map(|v| {
+                let (r, v) = (&refs[v.series], &v.verification);
+                serde_json::json!({
+                "time": r.time_label(v.offset as f64), "cc": v.agreement.cc,
+                "mae_hz": v.agreement.mae_hz, "rmse_hz": v.agreement.rmse_hz, "rank": v.rank, "p_value": v.p_value,
+                "best_fit": v.rank == 1, "consistent": v.rank == 1 && v.p_value < alpha})}),
+        })
+    }
+}
