@@ -8,11 +8,11 @@ use eenf_dsp::{
     flicker_lines, EnfParams, FlickerLine, Grouping, PolaritySequence, SamplingMethod,
     TemporalSampler, MIN_FLICKER_PROMINENCE,
 };
-use eenf_events::{OpenOptions, StreamInfo};
+use eenf_events::{EventReader, OpenOptions, StreamInfo};
 
-use crate::flicker_map::{flicker_map, TileMask};
+use crate::flicker_map::{flicker_map_of, TileMask};
 use crate::progress::Progress;
-use crate::recording::Recording;
+use crate::recording::{Peeked, Recording};
 use crate::trace::{EventsProvenance, Trace};
 use eenf_core::Nominal;
 
@@ -202,10 +202,17 @@ pub fn sample_recording(
         };
         (None, open, Some(note))
     };
-    let mask = tile_mask(rec, &open, opts, progress)?;
-    let reader = match (reader, &mask) {
-        (Some(r), None) => r,
-        _ => rec.open(&open)?,
+    // one read for the flicker map (when tiles are wanted) and one for the trace; a file whose
+    // reader is already open is read on from it
+    let reader = Peeked::new(match reader {
+        Some(r) => r,
+        None => rec.open(&open)?,
+    })?;
+    let (reader, mask): (Box<dyn EventReader>, _) = if wants_tiles(opts, &reader) {
+        let map = flicker_map_of(Box::new(reader), path, None, progress)?;
+        (rec.open(&open)?, TileMask::from_map(&map))
+    } else {
+        (Box::new(reader), None)
     };
     let mut s = sample_reader(
         reader,
@@ -219,35 +226,25 @@ pub fn sample_recording(
     Ok(s)
 }
 
-/// The tiles to trace, when `opts` asks for them and the stream stamps its events one by one
-/// (a DVXplorer's scans are sampled whole, as the paper does, and are left alone).
-fn tile_mask(
-    rec: &Recording,
-    open: &OpenOptions,
-    opts: &ExtractOptions,
-    progress: &Progress,
-) -> Result<Option<TileMask>> {
+/// Whether to trace only the tiles that flicker: when `opts` asks for them, the header gives
+/// the sensor's size, and the stream stamps its events one by one (a DVXplorer's scans are
+/// sampled whole, as the paper does, and are left alone).
+fn wants_tiles(opts: &ExtractOptions, reader: &Peeked) -> bool {
     if !opts.flicker_tiles
         || !matches!(
             opts.sampling,
             SamplingMethod::Auto | SamplingMethod::Block | SamplingMethod::Sum
         )
+        || reader.info().width.is_none()
     {
-        return Ok(None);
+        return false;
     }
-    let mut reader = rec.open(open)?;
-    if reader.info().width.is_none() {
-        return Ok(None);
+    match reader.first() {
+        None => false,
+        Some(first) => {
+            !(opts.sampling == SamplingMethod::Auto && Grouping::measure(&first.t).is_scanned())
+        }
     }
-    let Some(first) = reader.next_batch()? else {
-        return Ok(None);
-    };
-    if opts.sampling == SamplingMethod::Auto && Grouping::measure(&first.t).is_scanned() {
-        return Ok(None);
-    }
-    drop(reader);
-    let map = flicker_map(rec, open, None, progress)?;
-    Ok(TileMask::from_map(&map))
 }
 
 /// Reads an event file into its flicker signal (see [`sample_recording`]).

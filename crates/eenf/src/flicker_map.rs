@@ -68,8 +68,16 @@ pub fn flicker_map(
     tile: Option<u16>,
     progress: &Progress,
 ) -> Result<FlickerMap> {
-    let path = rec.name();
-    let mut reader = rec.open(open)?;
+    flicker_map_of(rec.open(open)?, rec.name(), tile, progress)
+}
+
+/// Maps the flicker of the events `reader` gives (the recording `path`), as [`flicker_map`].
+pub fn flicker_map_of(
+    mut reader: Box<dyn eenf_events::EventReader>,
+    path: &std::path::Path,
+    tile: Option<u16>,
+    progress: &Progress,
+) -> Result<FlickerMap> {
     let info = reader.info().clone();
     let (Some(width), Some(height)) = (info.width, info.height) else {
         bail!(

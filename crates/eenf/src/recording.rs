@@ -53,3 +53,48 @@ impl Recording {
         })
     }
 }
+
+/// A reader whose first batch was looked at (to tell how the camera stamps its events) and is
+/// handed out again first, so that the look costs no second opening of the file.
+pub struct Peeked {
+    first: Option<EventBatch>,
+    inner: Box<dyn EventReader>,
+}
+
+impl Peeked {
+    /// Reads the first batch of `inner` (`None`: the stream is empty or ended at damage).
+    pub fn new(mut inner: Box<dyn EventReader>) -> Result<Self> {
+        let first = inner.next_batch()?;
+        Ok(Peeked { first, inner })
+    }
+
+    /// The first batch, still to be handed out.
+    pub fn first(&self) -> Option<&EventBatch> {
+        self.first.as_ref()
+    }
+}
+
+impl EventReader for Peeked {
+    fn info(&self) -> &eenf_events::StreamInfo {
+        self.inner.info()
+    }
+
+    fn next_batch(&mut self) -> eenf_events::Result<Option<EventBatch>> {
+        match self.first.take() {
+            Some(b) => Ok(Some(b)),
+            None => self.inner.next_batch(),
+        }
+    }
+
+    fn skipped(&self) -> Vec<(&'static str, u64)> {
+        self.inner.skipped()
+    }
+
+    fn batch_offset(&self) -> Option<u64> {
+        self.inner.batch_offset()
+    }
+
+    fn damage(&self) -> Option<&eenf_events::Damage> {
+        self.inner.damage()
+    }
+}
