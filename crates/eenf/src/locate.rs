@@ -158,13 +158,7 @@ pub fn match_grid(trace: &Trace, name: &Path) -> Result<f64> {
     if trace.step_s <= 0.0 {
         bail!("{}: times must increase", name.display());
     }
-    trace.grid_hz().with_context(|| {
-        format!(
-            "{}: mean {:.3} Hz is neither a 50 nor a 60 Hz grid",
-            name.display(),
-            trace.mean_hz()
-        )
-    })
+    trace.grid_or_err(name)
 }
 
 impl MatchReport {

@@ -479,11 +479,5 @@ fn nominal_of(trace: &Trace, path: &Path) -> Result<f64> {
     if trace.finite().next().is_none() {
         bail!("{}: no values", path.display());
     }
-    trace.grid_hz().with_context(|| {
-        format!(
-            "{}: mean {:.3} Hz is neither a 50 nor a 60 Hz grid",
-            path.display(),
-            trace.mean_hz()
-        )
-    })
+    trace.grid_or_err(path)
 }

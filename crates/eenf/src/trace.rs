@@ -390,6 +390,17 @@ impl Trace {
         [50.0, 60.0].into_iter().find(|f| (mean - f).abs() < 1.0)
     }
 
+    /// [`Trace::grid_hz`], or an error naming the trace `name` and its mean.
+    pub fn grid_or_err(&self, name: &Path) -> Result<f64> {
+        self.grid_hz().ok_or_else(|| {
+            anyhow::anyhow!(
+                "{}: mean {:.3} Hz is neither a 50 nor a 60 Hz grid",
+                name.display(),
+                self.mean_hz()
+            )
+        })
+    }
+
     /// Writes `time_s,enf_hz` rows (an empty field for no estimate), and `snr_db` as a third
     /// column when the trace measured it.
     pub fn write_csv(&self, w: &mut dyn Write) -> Result<()> {
