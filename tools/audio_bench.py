@@ -2,7 +2,7 @@
 
 Writes MINUTES of 44.1 kHz 16-bit mono hum with a known ENF (a slow swing and a random walk
 around 50 Hz, lines at f0, 2f0 and 3f0, in broadband noise) to target/audio-bench/, then runs
-`eenf reference` and `libhum compute_enf` on it, paired, RUNS times each, and prints wall time
+`eenf reference`, `eenf edits` and `libhum compute_enf` on it, paired, RUNS times each, and prints wall time
 and peak memory (GNU time), and eenf's agreement with the truth.
 
 Usage: python tools/audio_bench.py [MINUTES] [RUNS]   (defaults 60 and 3)
@@ -58,9 +58,11 @@ def timed(cmd):
 
 
 libhum = shutil.which("libhum")
-rows = {"eenf": [], "libhum": []}
+rows = {"eenf": [], "edits": [], "libhum": []}
 for _ in range(runs):
     rows["eenf"].append(timed([eenf, "-q", "reference", wav, "-o", os.path.join(out, "eenf.csv")]))
+    # `eenf edits` reads the same hour and tests every boundary of it
+    rows["edits"].append(timed([eenf, "-q", "edits", wav, "-o", os.path.join(out, "edits.json")]))
     if libhum:
         rows["libhum"].append(timed([libhum, "compute_enf", wav, os.path.join(out, "libhum.enf")]))
 

@@ -7,6 +7,7 @@ use std::str::FromStr;
 
 use anyhow::{bail, Context, Result};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
+use eenf::edits::{EditInput, EditOptions, EditParams};
 use eenf::extract::ExtractOptions;
 use eenf::simulation::{EnfSource, Recipe};
 use eenf_core::{defaults, Nominal};
@@ -663,6 +664,73 @@ impl MatchArgs {
             score: self.score,
             verify: self.verify.clone(),
             alpha: self.alpha,
+        }
+    }
+}
+
+/// How `edits` tests a recording (also the Python package's `edits` keywords).
+#[derive(Debug, Clone, clap::Args)]
+pub struct EditArgs {
+    /// Nominal grid frequency: 50, 60, or auto (from the hum).
+    #[arg(long, default_value = "auto")]
+    pub nominal: Nominal,
+    /// The longest stretch whose phase is fitted on each side of a boundary, s.
+    #[arg(long, default_value_t = EditParams::default().side_s, value_parser = number_in(1.0, 600.0))]
+    pub side: f64,
+    /// The shortest stretch between two edits told apart, s (also the shortest side fitted:
+    /// the first and last this much of a recording are not tested).
+    #[arg(long, default_value_t = EditParams::default().min_gap_s, value_parser = number_in(0.3, 600.0))]
+    pub min_gap: f64,
+    /// False alarms allowed per hour of unedited recording: sets the phase test's threshold
+    /// from the noise measured in the recording.
+    #[arg(long, default_value_t = EditParams::default().false_alarms_per_hour, value_parser = number_in(1e-9, 100.0))]
+    pub false_alarms: f64,
+    /// Report stretches where a phase jump this large (degrees of the lowest line) would go
+    /// unseen as too weak to tell.
+    #[arg(long, default_value_t = EditParams::default().weak_jump_deg, value_parser = number_in(1.0, 180.0))]
+    pub weak_jump: f64,
+    /// A frequency step is reported when it stands this many robust standard deviations of
+    /// the recording's own steps.
+    #[arg(long, default_value_t = EditParams::default().frequency_step_z, value_parser = number_in(1.0, 1000.0))]
+    pub step_z: f64,
+    /// The channel of a sound: `mix` (the mean of all) or a number from 0.
+    #[arg(long, default_value = "mix")]
+    pub channel: eenf::audio::Channel,
+    /// What the file is: auto (an event file when its content says so, a trace when its
+    /// name ends in .csv or .json, else sound), audio, events, or trace.
+    #[arg(long, default_value = "auto", value_parser = one_of::<EditInput>(&EditInput::NAMES))]
+    pub kind: EditInput,
+    /// How an event file is read.
+    #[command(flatten)]
+    pub input: InputArgs,
+}
+
+impl EditArgs {
+    /// The test's parameters.
+    pub fn params(&self) -> EditParams {
+        EditParams {
+            side_s: self.side,
+            min_gap_s: self.min_gap.min(self.side),
+            false_alarms_per_hour: self.false_alarms,
+            weak_jump_deg: self.weak_jump,
+            frequency_step_z: self.step_z,
+        }
+    }
+
+    /// Everything `edits` needs: the test, the grid, how sound and events are read.
+    pub fn options(&self) -> EditOptions {
+        EditOptions {
+            params: self.params(),
+            input: self.kind,
+            audio: eenf::audio::AudioOptions {
+                channel: self.channel,
+                top_hz: None,
+            },
+            extract: ExtractOptions {
+                nominal: self.nominal,
+                open: self.input.options(),
+                ..ExtractOptions::default()
+            },
         }
     }
 }

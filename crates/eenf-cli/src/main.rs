@@ -41,6 +41,9 @@ enum Command {
     /// Build or inspect a reference store: long ENF series per grid for `match`.
     #[command(subcommand)]
     Refdb(commands::refdb::Cmd),
+    /// Was a recording edited? Cuts and insertions from the mains hum's phase and frequency,
+    /// in sound, event recordings, or (frequency steps alone) an ENF trace.
+    Edits(commands::edits::Args),
     /// Find when a trace was recorded by matching it against long references.
     Match(commands::matching::Args),
     /// Extract the ENF trace from a conventional video's rolling-shutter flicker (V-ENF).
@@ -88,6 +91,7 @@ fn main() -> ExitCode {
         Command::Reference(a) => commands::reference::run(a, progress),
         Command::Compare(a) => commands::compare::run(a, progress),
         Command::Refdb(c) => commands::refdb::run(c, progress),
+        Command::Edits(a) => commands::edits::run(a, progress),
         Command::Match(a) => commands::matching::run(a, progress),
         Command::Video(a) => commands::video::run(a, progress),
         Command::Simulate(a) => commands::simulate::run(a, progress),

@@ -22,6 +22,7 @@
 pub mod butter;
 pub mod chirp;
 pub mod decimate;
+pub mod edits;
 pub mod enf;
 pub mod filtfilt;
 pub mod flicker;

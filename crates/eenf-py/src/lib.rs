@@ -19,12 +19,12 @@ use eenf::progress::Progress;
 use eenf::recording::Recording;
 use eenf::trace::Trace;
 use eenf_cli::args::{
-    AudioArgs, EventOutputArgs, InputArgs, MatchArgs, MethodArgs, SimulateArgs, TrackerArgs,
-    VideoMethodArgs,
+    AudioArgs, EditArgs, EventOutputArgs, InputArgs, MatchArgs, MethodArgs, SimulateArgs,
+    TrackerArgs, VideoMethodArgs,
 };
 use eenf_core::Nominal;
 use eenf_events::{EventBatch, EventReader};
-use numpy::{PyArray1, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyStopIteration, PyValueError};
 use pyo3::prelude::*;
 
@@ -117,6 +117,7 @@ fn option_set(what: &str) -> PyResult<clap::Command> {
         "simulate" => SimulateArgs::augment_args(c),
         "match" => MatchArgs::augment_args(c),
         "write" => EventOutputArgs::augment_args(c),
+        "edits" => EditArgs::augment_args(c),
         _ => return Err(PyValueError::new_err(format!("no option set {what:?}"))),
     })
 }
@@ -674,6 +675,67 @@ fn write_events(
     .map_err(py_err)
 }
 
+/// An edits report: its JSON, and the figure's series (time, phase deviation, strength over
+/// threshold, ENF).
+type EditsOut<'py> = (
+    String,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+);
+
+fn edits_out(py: Python<'_>, r: anyhow::Result<eenf::edits::EditReport>) -> PyResult<EditsOut<'_>> {
+    let r = r.map_err(py_err)?;
+    let s = r.series.clone();
+    Ok((
+        r.to_json(),
+        s.time_s.into_pyarray(py),
+        s.phase_deg.into_pyarray(py),
+        s.strength.into_pyarray(py),
+        s.enf_hz.into_pyarray(py),
+    ))
+}
+
+/// Edits of a file (`eenf edits`). The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (path, argv=Vec::new()))]
+fn edits<'py>(py: Python<'py>, path: PathBuf, argv: Vec<String>) -> PyResult<EditsOut<'py>> {
+    let a = parse::<EditArgs>("edits", argv)?;
+    let opts = a.options();
+    let r = py.detach(|| eenf::edits::file_edits(&path, &opts, &Progress::hidden()));
+    edits_out(py, r)
+}
+
+/// Edits of samples in memory: `interleaved` frames of `channels` channels at `fs` Hz.
+#[pyfunction]
+#[pyo3(signature = (interleaved, channels, fs, name, argv=Vec::new()))]
+fn edits_samples<'py>(
+    py: Python<'py>,
+    interleaved: PyReadonlyArray1<'_, f32>,
+    channels: usize,
+    fs: f64,
+    name: PathBuf,
+    argv: Vec<String>,
+) -> PyResult<EditsOut<'py>> {
+    let a = parse::<EditArgs>("edits", argv)?;
+    let opts = a.options();
+    let samples = interleaved
+        .as_slice()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?
+        .to_vec();
+    let r = py.detach(|| {
+        let sound = Sound::Samples {
+            name: &name,
+            interleaved: &samples,
+            channels,
+            fs,
+        };
+        eenf::edits::sound_edits(&sound, &opts.audio, opts.extract.nominal, &opts.params)
+    });
+    edits_out(py, r)
+}
+
 /// The native module.
 #[pymodule]
 fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -693,5 +755,7 @@ fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(match_trace, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(write_events, m)?)?;
+    m.add_function(wrap_pyfunction!(edits, m)?)?;
+    m.add_function(wrap_pyfunction!(edits_samples, m)?)?;
     Ok(())
 }

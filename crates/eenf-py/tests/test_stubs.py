@@ -10,7 +10,8 @@ from eenf import _eenf
 STUB = Path(eenf.__file__).with_name("__init__.pyi")
 SETS = {"read_events": ["input"], "iter_events": ["input"], "info": ["input"],
         "extract": ["extract"], "reference": ["reference"], "video": ["video"],
-        "match": ["match"], "simulate": ["simulate"], "write_events": ["write"]}
+        "match": ["match"], "simulate": ["simulate"], "write_events": ["write"],
+        "edits": ["edits"]}
 
 
 def stub_functions():

@@ -11,6 +11,7 @@
 //! - [`reference`]: where a reference comes from ([`reference::ReferenceSource`]), the long
 //!   series [`locate`] searches (`match`), and the store [`refdb`] keeps them in.
 //! - [`evaluate`]: a `Trace` against its reference → an `Agreement` (CC, MAE, RMSE, max).
+//! - [`edits`]: was a recording edited? Cuts and insertions from the hum's phase.
 //! - [`bench`]: every method over a dataset, Table 2 and its reports; [`simulation`] and
 //!   [`dataset`]: simulated recordings and datasets with their truth.
 //!
@@ -23,6 +24,7 @@
 pub mod audio;
 pub mod bench;
 pub mod dataset;
+pub mod edits;
 pub mod evaluate;
 pub mod extract;
 pub mod flicker_map;

@@ -37,7 +37,7 @@ pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<f64>
 }
 
 /// The grids a `--nominal` leaves open.
-fn grids_of(nominal: Nominal) -> &'static [f64] {
+pub(crate) fn grids_of(nominal: Nominal) -> &'static [f64] {
     match nominal {
         Nominal::Auto => &[50.0, 60.0],
         Nominal::Hz(50.0) => &[50.0],

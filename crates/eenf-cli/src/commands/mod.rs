@@ -15,6 +15,7 @@ pub mod bench;
 pub mod compare;
 pub mod convert;
 pub mod demo;
+pub mod edits;
 pub mod extract;
 pub mod flicker_map;
 pub mod info;

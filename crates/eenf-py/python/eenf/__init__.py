@@ -56,6 +56,7 @@ __all__ = [
     "compare",
     "match",
     "simulate",
+    "edits",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -387,6 +388,21 @@ def extract(
     return _trace(_eenf.extract_events(t, x, y, p, w, h, name, _flags(params)))
 
 
+def _frames(source: Any, what: str) -> np.ndarray:
+    """Samples in memory as float32 frames × channels (integers scaled to ±1)."""
+    a = np.asarray(source)
+    if a.ndim == 1:
+        a = a[:, None]
+    if a.ndim != 2 or a.size == 0:
+        raise ValueError(f"{what}: samples must be (frames,) or (frames, channels), not {a.shape}")
+    if a.dtype.kind in "iu":
+        bits = a.dtype.itemsize * 8
+        a = a.astype(np.float32) / np.float32(2 ** (bits - 1))
+    elif a.dtype.kind != "f":
+        raise TypeError(f"{what}: samples must be numbers, not {a.dtype}")
+    return np.ascontiguousarray(a, dtype=np.float32)
+
+
 def reference(
     source: Any, fs: Optional[float] = None, *, name: str = "<samples>", **params: Any
 ) -> Trace:
@@ -399,20 +415,38 @@ def reference(
         return _trace(_eenf.reference(os.fspath(source), _flags(params)))
     if fs is None:
         raise TypeError("reference: samples in memory need their rate: fs=...")
-    a = np.asarray(source)
-    if a.ndim == 1:
-        a = a[:, None]
-    if a.ndim != 2 or a.size == 0:
-        raise ValueError(f"reference: samples must be (frames,) or (frames, channels), not {a.shape}")
-    if a.dtype.kind in "iu":
-        bits = a.dtype.itemsize * 8
-        a = a.astype(np.float32) / np.float32(2 ** (bits - 1))
-    elif a.dtype.kind != "f":
-        raise TypeError(f"reference: samples must be numbers, not {a.dtype}")
-    frames = np.ascontiguousarray(a, dtype=np.float32)
+    frames = _frames(source, "reference")
     return _trace(
         _eenf.reference_samples(frames.reshape(-1), frames.shape[1], float(fs), name, _flags(params))
     )
+
+
+def edits(
+    source: Any, fs: Optional[float] = None, *, name: str = "<samples>", **params: Any
+) -> Dict[str, Any]:
+    """Was a recording edited? Cuts and insertions from the mains hum's phase and frequency
+    (``eenf edits``): a file (sound in any container ``reference`` reads, an event file, or an
+    ENF trace for frequency steps alone), or sound samples in memory at ``fs`` Hz.
+
+    Returns the report ``eenf edits --json`` prints, as a dict (``edits``: each with
+    ``time_s``, ``kind``, ``phase_jump_deg``, ``strength``, ``false_alarms_per_hour``,
+    ``p_value``, …; ``undecided``: stretches too weak to tell; ``verdict``), with
+    ``series``: numpy arrays ``time_s``, ``phase_deg``, ``strength`` and ``enf_hz`` (the
+    figure's data)."""
+    if _is_path(source):
+        if fs is not None:
+            raise ValueError("fs is for samples in memory; a file gives its own rate")
+        out = _eenf.edits(os.fspath(source), _flags(params))
+    else:
+        if fs is None:
+            raise TypeError("edits: samples in memory need their rate: fs=...")
+        frames = _frames(source, "edits")
+        out = _eenf.edits_samples(
+            frames.reshape(-1), frames.shape[1], float(fs), name, _flags(params)
+        )
+    report = json.loads(out[0])
+    report["series"] = dict(zip(("time_s", "phase_deg", "strength", "enf_hz"), out[1:]))
+    return report
 
 
 def video(path: PathLike, **params: Any) -> Trace:
@@ -547,3 +581,4 @@ _document(video, "video")
 _document(match, "match")
 _document(simulate, "simulate")
 _document(write_events, "write")
+_document(edits, "edits")

@@ -146,6 +146,24 @@ def reference(
     step: float = 1.0,
     half_band: float = 2.0,
 ) -> Trace: ...
+def edits(
+    source: Union[PathLike, npt.ArrayLike],
+    fs: Optional[float] = None,
+    *,
+    name: str = "<samples>",
+    nominal: Nominal = "auto",
+    side: float = 10.0,
+    min_gap: float = 1.0,
+    false_alarms: float = 0.05,
+    weak_jump: float = 90.0,
+    step_z: float = 10.0,
+    channel: Union[Literal["mix"], int] = "mix",
+    kind: Literal["auto", "audio", "events", "trace"] = "auto",
+    chip: Optional[str] = None,
+    camera: Optional[int] = None,
+    strict: bool = False,
+    max_gap: float = 5.0,
+) -> Dict[str, Any]: ...
 def video(
     path: PathLike,
     *,
