@@ -13,13 +13,13 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Result};
 use eenf_dsp::edits::{baseband, false_alarms_per_hour, scan_phase, BoundaryTest, PhaseScan};
 use eenf_dsp::hum::{MAX_HUM_HARMONIC, MIN_CLIP_S};
-use eenf_dsp::{decimate, decimation_for, search_hum};
+use eenf_dsp::search_hum;
 use serde::Serialize;
 
 pub use eenf_dsp::edits::EditParams;
 
 use crate::audio::{AudioOptions, Sound};
-use crate::extract::{sample_recording, ExtractOptions};
+use crate::extract::{flicker_signal, sample_recording, ExtractOptions};
 use crate::mains::grids_of;
 use crate::progress::Progress;
 use crate::recording::Recording;
@@ -306,16 +306,7 @@ pub fn event_edits(
     let top_grid = grids.iter().fold(0.0f64, |a, &b| a.max(b));
     // the flicker's lines up to 4·2f0, each with its floor beside it
     const FLICKER_LINES: usize = 4;
-    let top = 2.0 * top_grid * FLICKER_LINES as f64 + 10.0;
-    let (factor, cutoff) = decimation_for(seq.fs(), top);
-    let (x, fs) = if factor > 1 {
-        (
-            decimate(&seq.signal(), seq.fs(), factor, cutoff),
-            seq.fs() / factor as f64,
-        )
-    } else {
-        (seq.signal(), seq.fs())
-    };
+    let (x, fs) = flicker_signal(seq, 2.0 * top_grid * FLICKER_LINES as f64 + 10.0);
     let duration_s = seq.duration_s();
     let search = search_hum(&x, fs, 2.0, grids, FLICKER_LINES).ok_or_else(|| {
         anyhow!(

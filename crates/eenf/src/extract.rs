@@ -316,6 +316,21 @@ fn decide_grid(
     Ok((f0, line, note))
 }
 
+/// The flicker signal of `seq`, brought down to the lowest rate that keeps every band up to
+/// `top_hz` (anti-aliased, so that the flicker's higher harmonics do not fold onto them), and
+/// that rate.
+pub fn flicker_signal(seq: &PolaritySequence, top_hz: f64) -> (Vec<f64>, f64) {
+    let (factor, cutoff) = decimation_for(seq.fs(), top_hz);
+    if factor > 1 {
+        (
+            decimate(&seq.signal(), seq.fs(), factor, cutoff),
+            seq.fs() / factor as f64,
+        )
+    } else {
+        (seq.signal(), seq.fs())
+    }
+}
+
 /// E-ENF from a flicker signal already read from `path`.
 pub fn extract_sampled(
     path: &Path,
@@ -332,15 +347,7 @@ pub fn extract_sampled(
         Nominal::Auto => 60.0,
     };
     let top = 2.0 * grid * params.harmonics.max(1) as f64 + params.half_band_hz;
-    let (factor, cutoff) = decimation_for(seq.fs(), top);
-    let (x, fs) = if factor > 1 {
-        (
-            decimate(&seq.signal(), seq.fs(), factor, cutoff),
-            seq.fs() / factor as f64,
-        )
-    } else {
-        (seq.signal(), seq.fs())
-    };
+    let (x, fs) = flicker_signal(seq, top);
     let mut notes = s.notes;
     let err = |e: eenf_dsp::DspError| anyhow::anyhow!("{}: {e}", path.display());
     let duration = seq.duration_s();
