@@ -696,6 +696,10 @@ pub struct EditArgs {
     /// The channel of a sound: `mix` (the mean of all) or a number from 0.
     #[arg(long, default_value = "mix")]
     pub channel: eenf::audio::Channel,
+    /// Seconds between the values of an `index,value` trace CSV (a grid archive's day of
+    /// values, for instance); a `time_s,enf_hz` CSV or eenf JSON carries its own times.
+    #[arg(long, value_parser = number_in(0.001, 3600.0))]
+    pub index_step: Option<f64>,
     /// What the file is: auto (an event file when its content says so, a trace when its
     /// name ends in .csv or .json, else sound), audio, events, or trace.
     #[arg(long, default_value = "auto", value_parser = one_of::<EditInput>(&EditInput::NAMES))]
@@ -722,6 +726,7 @@ impl EditArgs {
         EditOptions {
             params: self.params(),
             input: self.kind,
+            index_step_s: self.index_step,
             audio: eenf::audio::AudioOptions {
                 channel: self.channel,
                 top_hz: None,

@@ -200,6 +200,8 @@ pub struct EditOptions {
     pub params: EditParams,
     /// What the file is.
     pub input: EditInput,
+    /// Seconds between the values of an `index,value` trace CSV.
+    pub index_step_s: Option<f64>,
     /// How a sound is read (the channel).
     pub audio: AudioOptions,
     /// How an event file is read and its flicker sampled; its `nominal` is the grid for
@@ -228,7 +230,7 @@ pub fn file_edits(path: &Path, opts: &EditOptions, progress: &Progress) -> Resul
     };
     match kind {
         EditInput::Trace => {
-            let trace = Trace::read(path, None)?;
+            let trace = Trace::read(path, opts.index_step_s)?;
             trace_edits(&trace, path, &opts.params)
         }
         EditInput::Events => event_edits(

@@ -158,6 +158,7 @@ def edits(
     weak_jump: float = 90.0,
     step_z: float = 10.0,
     channel: Union[Literal["mix"], int] = "mix",
+    index_step: Optional[float] = None,
     kind: Literal["auto", "audio", "events", "trace"] = "auto",
     chip: Optional[str] = None,
     camera: Optional[int] = None,
