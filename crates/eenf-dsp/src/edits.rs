@@ -90,14 +90,17 @@ pub fn baseband(x: &[f64], fs: f64, f0_hz: f64, multiples: &[u32]) -> Baseband {
         .par_iter()
         .map(|&m| {
             let w = -2.0 * std::f64::consts::PI * m as f64 * f0_hz / fs;
+            let step = Complex64::from_polar(1.0, w);
             (0..n)
                 .map(|b| {
+                    // each block starts from its phase computed from the sample index (no drift
+                    // over hours) and turns sample by sample within it
+                    let start = (w * (b * nb) as f64).rem_euclid(std::f64::consts::TAU);
+                    let mut turn = Complex64::from_polar(1.0, start);
                     let mut acc = Complex64::new(0.0, 0.0);
-                    for (i, &v) in x[b * nb..(b + 1) * nb].iter().enumerate() {
-                        // the phase from the sample index, never accumulated: no drift over hours
-                        let ph = (w * (b * nb + i) as f64).rem_euclid(std::f64::consts::TAU);
-                        let (s, c) = ph.sin_cos();
-                        acc += Complex64::new(v * c, v * s);
+                    for &v in &x[b * nb..(b + 1) * nb] {
+                        acc += turn * v;
+                        turn *= step;
                     }
                     acc / nb as f64
                 })
@@ -632,38 +635,40 @@ impl Lines {
                 .map(|i| 2.0 * kappa[i] * ((d[i] - self.multiples[i] * delta).cos() - d[i].cos()))
                 .sum()
         };
-        // a grid of 2° over the fundamental's jump, then a parabola through the best
-        let steps = 180;
-        let h = std::f64::consts::TAU / steps as f64;
-        let (mut best_i, mut best) = (0usize, f64::MIN);
-        let vals: Vec<f64> = (0..steps)
-            .map(|i| ll(-std::f64::consts::PI + i as f64 * h))
-            .collect();
-        for (i, &v) in vals.iter().enumerate() {
-            if v > best {
-                best = v;
-                best_i = i;
+        // the best jump of the fundamental: each line alone is best at (d_k + 2πj)/m_k; from
+        // each of those, Newton's steps climb Σ κ_k cos(d_k − m_k Δ) to its nearest peak
+        let (mut jump, mut best) = (0.0, 0.0);
+        for i in 0..k {
+            let m = self.multiples[i];
+            for j in 0..(m.round() as usize).max(1) {
+                let mut x = wrap((d[i] + std::f64::consts::TAU * j as f64) / m);
+                for _ in 0..4 {
+                    let (mut g, mut h) = (0.0, 0.0);
+                    for l in 0..k {
+                        let ml = self.multiples[l];
+                        let (sn, cs) = (d[l] - ml * x).sin_cos();
+                        g += kappa[l] * ml * sn;
+                        h -= kappa[l] * ml * ml * cs;
+                    }
+                    if h >= 0.0 {
+                        break;
+                    }
+                    x = wrap(x - g / h);
+                }
+                let v = ll(x);
+                if v > best {
+                    best = v;
+                    jump = x;
+                }
             }
         }
-        let (a, b, c) = (
-            vals[(best_i + steps - 1) % steps],
-            vals[best_i],
-            vals[(best_i + 1) % steps],
-        );
-        let den = a - 2.0 * b + c;
-        let off = if den < 0.0 {
-            (0.5 * (a - c) / den).clamp(-0.5, 0.5)
-        } else {
-            0.0
-        };
-        let jump = wrap(-std::f64::consts::PI + (best_i as f64 + off) * h);
         let info: f64 = (0..k)
             .map(|i| kappa[i] * self.multiples[i] * self.multiples[i])
             .sum();
         // the grid's own stray from the fit, common to the lines: T ≈ Δ²·info becomes
         // Δ² / (1/info + stray²)
         let stray = self.stray_rad;
-        let statistic = ll(jump).max(best).max(0.0) / (1.0 + stray * stray * info);
+        let statistic = best.max(0.0) / (1.0 + stray * stray * info);
         let info = info / (1.0 + stray * stray * info);
         BoundaryTest {
             block: tau,
