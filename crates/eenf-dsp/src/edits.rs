@@ -542,7 +542,7 @@ pub fn threshold_for(rate: f64, lines: usize, params: &EditParams) -> f64 {
 const GRID_STRAY_RAD: f64 = 1.22 * std::f64::consts::PI / 180.0;
 
 /// Wraps an angle into (−π, π].
-fn wrap(a: f64) -> f64 {
+pub fn wrap(a: f64) -> f64 {
     let w = (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
     if w <= -std::f64::consts::PI {
         w + std::f64::consts::TAU

@@ -464,10 +464,7 @@ pub fn plausibility(enf_hz: &[f64], step_s: f64, nominal_hz: f64, edge: usize) -
         *v.select_nth_unstable_by(m, f64::total_cmp).1
     };
     let offset_hz = median(&mut all) - nominal_hz;
-    let mut inner_c = inner.clone();
-    let centre = median(&mut inner_c);
-    let mut dev: Vec<f64> = inner.iter().map(|v| (v - centre).abs()).collect();
-    let spread_hz = 1.4826 * median(&mut dev);
+    let spread_hz = crate::metrics::robust_spread(&inner);
     let span_s = inner.len() as f64 * step_s;
     let mut flags = Vec::new();
     if offset_hz.abs() > USUAL_OFFSET_HZ {

@@ -50,7 +50,7 @@ pub use hum::{
     check_holds_line, choose_window, plausibility, search_hum, HumLine, HumSearch, HumVerdict,
     Plausibility,
 };
-pub use metrics::{agreement, Agreement};
+pub use metrics::{agreement, robust_spread, Agreement};
 pub use postprocess::{
     median_correct, select_audible_harmonics, select_harmonics, HarmonicSelection,
 };

@@ -54,6 +54,19 @@ pub fn agreement(est: &[f64], reference: &[f64]) -> Option<Agreement> {
     })
 }
 
+/// 1.4826 × the median absolute deviation of the finite values of `v`: the standard deviation
+/// of the bulk, unmoved by a few values that stand out (NaN when there are none).
+pub fn robust_spread(v: &[f64]) -> f64 {
+    let mut v: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mid = v.len() / 2;
+    let centre = *v.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let mut dev: Vec<f64> = v.iter().map(|x| (x - centre).abs()).collect();
+    1.4826 * *dev.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
-use eenf_dsp::edits::{baseband, false_alarms_per_hour, scan_phase, BoundaryTest, PhaseScan};
+use eenf_dsp::edits::{baseband, false_alarms_per_hour, scan_phase, wrap, BoundaryTest, PhaseScan};
 use eenf_dsp::hum::{MAX_HUM_HARMONIC, MIN_CLIP_S};
 use eenf_dsp::search_hum;
 use serde::Serialize;
@@ -287,7 +287,7 @@ pub fn sound_edits(
     let multiples: Vec<u32> = carriers.iter().map(|&k| k as u32).collect();
     let bb = baseband(&sig.samples, sig.fs, verdict.grid_hz, &multiples);
     let scan = scan_phase(&bb, params).ok_or_else(|| too_short(path, duration_s, params))?;
-    let mut r = report(path, "audio", &scan, duration_s, 0.0);
+    let mut r = report(path, "audio", &scan, duration_s);
     r.warnings.extend(a.warning);
     Ok(r)
 }
@@ -324,7 +324,7 @@ pub fn event_edits(
     };
     let bb = baseband(&x, fs, verdict.grid_hz, &multiples);
     let scan = scan_phase(&bb, params).ok_or_else(|| too_short(path, duration_s, params))?;
-    let mut r = report(path, "events", &scan, duration_s, 0.0);
+    let mut r = report(path, "events", &scan, duration_s);
     r.warnings.extend(s.notes);
     r.warnings.extend(s.damage.map(|d| d.to_string()));
     Ok(r)
@@ -435,18 +435,11 @@ fn too_short(path: &Path, duration_s: f64, params: &EditParams) -> anyhow::Error
     )
 }
 
-/// 1.4826 × the median absolute deviation: the standard deviation of the bulk, unmoved by a
-/// few steps that stand out.
+/// The recording's own spread of frequency steps (see [`eenf_dsp::robust_spread`]), kept off
+/// zero so that a perfectly smooth trace divides safely.
 fn robust_scale(v: impl Iterator<Item = f64>) -> f64 {
-    let mut v: Vec<f64> = v.filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    let mid = v.len() / 2;
-    let med = *v.select_nth_unstable_by(mid, f64::total_cmp).1;
-    let mut dev: Vec<f64> = v.iter().map(|x| (x - med).abs()).collect();
-    let m = *dev.select_nth_unstable_by(mid, f64::total_cmp).1;
-    (1.4826 * m).max(1e-12)
+    let v: Vec<f64> = v.collect();
+    eenf_dsp::robust_spread(&v).max(1e-12)
 }
 
 /// The places where |value| / `scale` passes `z`, strongest first, none within `radius` of a
@@ -465,19 +458,13 @@ fn peaks(values: &[(usize, f64)], radius: usize, scale: f64, z: f64) -> Vec<(usi
     kept
 }
 
-/// The report of a phase scan of a recording starting at `t0_s`.
-fn report(
-    path: &Path,
-    input: &'static str,
-    scan: &PhaseScan,
-    duration_s: f64,
-    t0_s: f64,
-) -> EditReport {
+/// The report of a phase scan (times from the recording's start).
+fn report(path: &Path, input: &'static str, scan: &PhaseScan, duration_s: f64) -> EditReport {
     let p = &scan.params;
     let tb = scan.block_s;
     let lowest = scan.multiples.first().copied().unwrap_or(1) as f64;
     let lines = scan.multiples.len();
-    let at = |block: usize| t0_s + block as f64 * tb;
+    let at = |block: usize| block as f64 * tb;
     let examined = match (scan.tests.first(), scan.tests.last()) {
         (Some(a), Some(b)) => [at(a.block), at(b.block)],
         _ => [0.0, 0.0],
@@ -493,7 +480,7 @@ fn report(
             let step = Some(t.frequency_step_hz);
             let z = step.map(|s| s / scale);
             let stepped = z.is_some_and(|z| z.abs() >= p.frequency_step_z);
-            let jump = wrap_deg((lowest * t.jump_rad).to_degrees());
+            let jump = wrap(lowest * t.jump_rad).to_degrees();
             Edit {
                 time_s: at(t.block),
                 end_s: None,
@@ -531,8 +518,8 @@ fn report(
                 }
                 if i - start >= 2 {
                     edits.push(Edit {
-                        time_s: t0_s + start as f64,
-                        end_s: Some(t0_s + i as f64),
+                        time_s: start as f64,
+                        end_s: Some(i as f64),
                         kind: EditKind::HumGap,
                         phase_jump_deg: None,
                         phase_jump_line_hz: None,
@@ -641,15 +628,5 @@ fn report(
             strength,
             enf_hz: scan.enf_hz.clone(),
         },
-    }
-}
-
-/// An angle in degrees wrapped into (−180, 180].
-fn wrap_deg(a: f64) -> f64 {
-    let w = (a + 180.0).rem_euclid(360.0) - 180.0;
-    if w <= -180.0 {
-        w + 360.0
-    } else {
-        w
     }
 }
