@@ -10,6 +10,7 @@ use clap::builder::{PossibleValuesParser, TypedValueParser};
 use eenf::edits::{EditInput, EditOptions, EditParams};
 use eenf::extract::ExtractOptions;
 use eenf::simulation::{EnfSource, Recipe};
+use eenf::time::Zone;
 use eenf_core::{defaults, Nominal};
 use eenf_dsp::{EnfParams, HarmonicSelection, PeakMethod, SamplingMethod};
 use eenf_events::writers::OutputFormat;
@@ -650,10 +651,11 @@ pub struct MatchArgs {
     /// A candidate is a match when its p-value is below this.
     #[arg(long, default_value_t = eenf_dsp::matching::DEFAULT_ALPHA, value_parser = number_in(1e-300, 1.0))]
     pub alpha: f64,
-    /// Zone of the local times in hourly WAV names, as a UTC offset (+08:00, Z); also the zone
-    /// results are shown in beside UTC. Names in local time need it: none is assumed.
+    /// Zone of the local times in hourly WAV names and grid archives: an IANA name
+    /// (Europe/Berlin, Asia/Shanghai; summer time followed) or a UTC offset (+08:00, Z); also
+    /// the zone results are shown in beside UTC. Local times need it: none is assumed.
     #[arg(long, allow_hyphen_values = true)]
-    pub tz: Option<String>,
+    pub tz: Option<Zone>,
 }
 
 impl MatchArgs {

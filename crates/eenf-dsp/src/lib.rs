@@ -30,6 +30,7 @@ pub mod hum;
 pub mod matching;
 pub mod metrics;
 pub mod postprocess;
+pub mod resample;
 pub mod sampling;
 pub mod spectrogram;
 pub mod tracker;

@@ -211,23 +211,6 @@ pub fn fill_gaps(x: &[f64]) -> Vec<f64> {
     out
 }
 
-/// Resamples a trace from `from_step` to `to_step` seconds (linear interpolation).
-pub fn resample(x: &[f64], from_step: f64, to_step: f64) -> Vec<f64> {
-    if (from_step - to_step).abs() < 1e-9 || x.len() < 2 {
-        return x.to_vec();
-    }
-    let span = (x.len() - 1) as f64 * from_step;
-    let n = (span / to_step).floor() as usize + 1;
-    (0..n)
-        .map(|j| {
-            let pos = j as f64 * to_step / from_step;
-            let i = (pos.floor() as usize).min(x.len() - 2);
-            let w = pos - i as f64;
-            x[i] * (1.0 - w) + x[i + 1] * w
-        })
-        .collect()
-}
-
 /// Pearson CC, MAE and RMSE of `q` against `r[k..k + q.len()]` over the values valid in both.
 fn score_at<R: ReferenceValues + ?Sized>(q: &[f64], r: &R, k: usize) -> Agreement {
     // one pass of running sums (this runs per candidate over long references); the two-pass
@@ -761,11 +744,7 @@ mod tests {
     }
 
     #[test]
-    fn resampling_and_gap_filling() {
-        assert_eq!(
-            resample(&[0.0, 2.0, 4.0], 2.0, 1.0),
-            vec![0.0, 1.0, 2.0, 3.0, 4.0]
-        );
+    fn gap_filling_and_tail_fit() {
         let f = fill_gaps(&[f64::NAN, 1.0, f64::NAN, 3.0, f64::NAN]);
         assert_eq!(f, vec![1.0, 1.0, 2.0, 3.0, 3.0]);
         // maxima 10, 9, 8, …: k = 3, u = 8, mean excess 1.5; a score at u is beaten by the

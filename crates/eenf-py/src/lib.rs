@@ -610,9 +610,15 @@ fn match_trace(
     let m: MatchArgs = parse("match", argv)?;
     let t = trace.0.clone();
     py.detach(|| {
-        let tz = m.tz.as_deref().map(eenf::time::tz_offset).transpose()?;
         let query = m.query();
-        let located = eenf::locate::locate(&t, &name, &reference, tz, &query, &Progress::hidden())?;
+        let located = eenf::locate::locate(
+            &t,
+            &name,
+            &reference,
+            m.tz.as_ref(),
+            &query,
+            &Progress::hidden(),
+        )?;
         Ok(located.to_json(&name, query.alpha).to_string())
     })
     .map_err(py_err)

@@ -9,7 +9,8 @@
 use std::path::PathBuf;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use eenf_dsp::matching::{match_trace, resample, MatchOptions};
+use eenf_dsp::matching::{match_trace, MatchOptions};
+use eenf_dsp::resample::resample;
 use eenf_sim::SyntheticEnf;
 
 const DAY: usize = 86_400;

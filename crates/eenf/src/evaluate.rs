@@ -57,6 +57,12 @@ impl Reference {
                 dir.display()
             );
         }
+        if let ReferenceSource::Archive(p) = &source {
+            bail!(
+                "{}: a grid archive: add it to a store with `refdb build` and search it with `match`",
+                p.display()
+            );
+        }
         if let ReferenceSource::HourlyFolder(_) = source {
             let start = recording_start(recording).with_context(|| {
                 format!(

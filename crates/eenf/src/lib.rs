@@ -21,6 +21,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod archive;
 pub mod audio;
 pub mod bench;
 pub mod dataset;

@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use eenf_dsp::matching::{resample, Candidate, MatchOptions, Score, Verification};
+use eenf_dsp::matching::{Candidate, MatchOptions, Score, Verification};
+use eenf_dsp::resample::resample;
 
 use crate::progress::Progress;
 use crate::reference::ReferenceSeries;
@@ -70,18 +71,18 @@ impl Located {
 }
 
 /// Where `trace` (named `name` in messages) fits in the references at `reference` (a store, a
-/// folder of hourly WAVs, a WAV or a trace; hourly names are local times in the zone `tz_s`
-/// seconds east of UTC), as `query` asks: the command's and the Python package's `match`.
+/// folder of hourly WAVs, a WAV, a grid archive or a trace; local times in hourly names and
+/// archives are in `zone`), as `query` asks: the command's and the Python package's `match`.
 pub fn locate(
     trace: &Trace,
     name: &Path,
     reference: &Path,
-    tz_s: Option<f64>,
+    zone: Option<&crate::time::Zone>,
     query: &MatchQuery,
     progress: &Progress,
 ) -> Result<Located> {
     let nominal_hz = match_grid(trace, name)?;
-    let references = ReferenceSeries::load(reference, nominal_hz, tz_s, progress)?;
+    let references = ReferenceSeries::load(reference, nominal_hz, zone, progress)?;
     let report = match_trace_in(trace, name, nominal_hz, &references, query)?;
     Ok(Located { report, references })
 }

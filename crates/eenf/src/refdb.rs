@@ -345,7 +345,7 @@ impl RefSeries {
     /// Places `hz` (one value per `step_s` from `start_unix_s`) into the series, resampled to
     /// the series' step; the series grows (with gaps) as needed, and new values replace old.
     pub fn merge(&mut self, start_unix_s: f64, step_s: f64, hz: &[f64]) -> Result<()> {
-        let vals = eenf_dsp::matching::resample(hz, step_s, self.meta.step_s);
+        let vals = eenf_dsp::resample::resample(hz, step_s, self.meta.step_s);
         let step = self.meta.step_s;
         if self.values.is_empty() {
             self.meta.start_unix_s = start_unix_s;

@@ -8,12 +8,13 @@ use anyhow::{bail, Context, Result};
 use eenf_dsp::matching::{match_trace, MatchError, MatchOptions, MatchResult, ScaledSeries};
 use eenf_dsp::{reference_enf, EnfParams};
 
+use crate::archive::{ArchiveImport, ArchiveOptions};
 use crate::audio::read_wav;
 use crate::dataset::hourly_references;
 use crate::mains::{mains_nominal, reference_file};
 use crate::progress::Progress;
 use crate::refdb::{check_grid_name, RefSeries, StoreLock, GAP};
-use crate::time::LocalTime;
+use crate::time::{LocalInstant, LocalTime, Zone};
 use crate::trace::Trace;
 use crate::wav::is_wav;
 use eenf_core::Nominal;
@@ -28,13 +29,17 @@ pub enum ReferenceSource {
     HourlyFolder(PathBuf),
     /// One mains WAV.
     Wav(PathBuf),
+    /// A grid operator's or measurement site's frequency archive: timestamped CSVs, plain or
+    /// in a zip, 7z or gzip file ([`crate::archive`]).
+    Archive(PathBuf),
     /// A trace file: eenf CSV or JSON, or an `index,value` CSV.
     Trace(PathBuf),
 }
 
 impl ReferenceSource {
     /// What `path` holds: a folder with grid manifests is a store, any other folder a folder of
-    /// hourly WAVs, a RIFF/WAVE file a WAV, anything else a trace file.
+    /// hourly WAVs, a RIFF/WAVE file a WAV, a table of dates and frequencies (or a zip, 7z or
+    /// gzip file) an archive, anything else a trace file.
     pub fn open(path: &Path) -> Result<Self> {
         let p = path.to_path_buf();
         Ok(if path.is_dir() {
@@ -45,6 +50,8 @@ impl ReferenceSource {
             }
         } else if is_wav(path) {
             ReferenceSource::Wav(p)
+        } else if crate::archive::is_archive(path) {
+            ReferenceSource::Archive(p)
         } else {
             ReferenceSource::Trace(p)
         })
@@ -56,6 +63,7 @@ impl ReferenceSource {
             ReferenceSource::Store(p)
             | ReferenceSource::HourlyFolder(p)
             | ReferenceSource::Wav(p)
+            | ReferenceSource::Archive(p)
             | ReferenceSource::Trace(p) => p,
         }
     }
@@ -138,20 +146,22 @@ pub fn reference_for_recording(
     Ok(Trace::from_mains(dir, f0, &p, out))
 }
 
-/// Unix time of an hourly reference's name read as local time at `tz_s` seconds east of UTC.
-/// The names carry no zone, so none is assumed: without `tz_s` it is an error that says how to
-/// give it.
-pub fn wav_start(path: &Path, tz_s: Option<f64>) -> Result<f64> {
+/// Unix time of an hourly reference's name read as local time in `zone`. The names carry no
+/// zone, so none is assumed: without one it is an error that says how to give it. An hour the
+/// clocks passed twice is read as its first passage (the name cannot tell), an hour they
+/// skipped is refused.
+pub fn wav_start(path: &Path, zone: Option<&Zone>) -> Result<f64> {
     let t = crate::dataset::reference_hour(path).with_context(|| {
         format!(
             "{}: the name gives no start time (expected 2022_08_17_Wed_16_00_00.wav)",
             path.display()
         )
     })?;
-    let Some(tz_s) = tz_s else {
+    let Some(zone) = zone else {
         bail!(
             "{}: its name gives a local time ({}-{:02}-{:02} {:02}:00) but not its zone: give the \
-             zone with --tz (e.g. --tz +08:00 where it was recorded in China, --tz Z for UTC)",
+             zone with --tz (e.g. --tz Asia/Shanghai or +08:00 where it was recorded in China, \
+             --tz Z for UTC)",
             path.display(),
             t.year(),
             t.month(),
@@ -159,7 +169,18 @@ pub fn wav_start(path: &Path, tz_s: Option<f64>) -> Result<f64> {
             t.hour()
         );
     };
-    Ok(t.unix_seconds(tz_s))
+    match zone.instant(t.local_seconds()) {
+        LocalInstant::Unique(u) | LocalInstant::Repeated(u, _) => Ok(u),
+        LocalInstant::Missing => bail!(
+            "{}: {}-{:02}-{:02} {:02}:00 does not exist in {} (the clocks skipped that hour)",
+            path.display(),
+            t.year(),
+            t.month(),
+            t.day(),
+            t.hour(),
+            zone.name()
+        ),
+    }
 }
 
 /// A long reference series that `match` searches: a store's grid, a folder of hourly WAVs, one
@@ -171,12 +192,14 @@ pub struct ReferenceSeries {
     pub start: f64,
     /// Whether `start` is an absolute time.
     pub absolute: bool,
-    /// The zone (seconds east of UTC) its times are also shown in, when one was given.
-    pub zone_s: Option<f64>,
+    /// The zone its times are also shown in, when one was given.
+    pub zone: Option<Zone>,
     /// Seconds between values.
     pub step: f64,
     /// The values.
     pub values: SeriesValues,
+    /// What reading it noted (an archive's layout, zone and dropped rows).
+    pub notes: Vec<String>,
 }
 
 /// Reference values: in Hz, or as stored (µHz from nominal), read in place.
@@ -240,9 +263,9 @@ impl ReferenceSeries {
     pub fn time_label(&self, offset: f64) -> String {
         let t = self.start + offset * self.step;
         if self.absolute {
-            match self.zone_s {
-                Some(z) if z != 0.0 => {
-                    format!("{} ({})", crate::time::utc(t), crate::time::local(t, z))
+            match &self.zone {
+                Some(z) if z.name() != "UTC" => {
+                    format!("{} ({})", crate::time::utc(t), z.local(t))
                 }
                 _ => crate::time::utc(t),
             }
@@ -252,11 +275,12 @@ impl ReferenceSeries {
     }
 
     /// The `nominal` Hz series at `path`: a store (its grids of that frequency), a folder of
-    /// hourly WAVs (traced, local names at `tz_s`), a WAV, or a trace file.
+    /// hourly WAVs (traced, local names in `zone`), a WAV, a grid archive (local times in
+    /// `zone`), or a trace file.
     pub fn load(
         path: &Path,
         nominal: f64,
-        tz_s: Option<f64>,
+        zone: Option<&Zone>,
         progress: &Progress,
     ) -> Result<Vec<Self>> {
         let source = ReferenceSource::open(path)?;
@@ -278,12 +302,13 @@ impl ReferenceSeries {
                         name: g,
                         start: meta.start_unix_s,
                         absolute: true,
-                        zone_s: tz_s,
+                        zone: zone.cloned(),
                         step: meta.step_s,
                         values: SeriesValues::Stored {
                             values: s.values,
                             nominal,
                         },
+                        notes: Vec::new(),
                     });
                 }
                 if out.is_empty() {
@@ -298,7 +323,7 @@ impl ReferenceSeries {
             for (_, f) in &files {
                 let trace = reference_file(f, Nominal::Auto, &EnfParams::default())?;
                 if trace.nominal_hz == Some(nominal) {
-                    series.merge(wav_start(f, tz_s)?, 1.0, &trace.enf_hz)?;
+                    series.merge(wav_start(f, zone)?, 1.0, &trace.enf_hz)?;
                 }
                 bar.inc(1);
             }
@@ -310,15 +335,35 @@ impl ReferenceSeries {
                 name: path.display().to_string(),
                 start: series.meta.start_unix_s,
                 absolute: true,
-                zone_s: tz_s,
+                zone: zone.cloned(),
                 step: 1.0,
                 values: SeriesValues::Hz(series.hz()),
+                notes: Vec::new(),
+            }]);
+        }
+        if let ReferenceSource::Archive(_) = source {
+            let opts = ArchiveOptions {
+                zone: zone.cloned(),
+                nominal_hz: Some(nominal),
+                ..ArchiveOptions::default()
+            };
+            let imp = crate::archive::import(path, &opts, None)?;
+            let mut notes = vec![format!("{}: {}", path.display(), imp.report)];
+            notes.extend(imp.report.warnings.iter().cloned());
+            return Ok(vec![ReferenceSeries {
+                notes,
+                name: path.display().to_string(),
+                start: imp.steps.start,
+                absolute: true,
+                zone: zone.cloned(),
+                step: imp.steps.step,
+                values: SeriesValues::Hz(imp.steps.values),
             }]);
         }
         let (start, absolute, step, hz) = if let ReferenceSource::Wav(_) = source {
             let trace = reference_file(path, Nominal::Hz(nominal), &EnfParams::default())?;
             if crate::dataset::reference_hour(path).is_some() {
-                (wav_start(path, tz_s)?, true, 1.0, trace.enf_hz)
+                (wav_start(path, zone)?, true, 1.0, trace.enf_hz)
             } else {
                 (0.0, false, 1.0, trace.enf_hz)
             }
@@ -335,9 +380,10 @@ impl ReferenceSeries {
             name: path.display().to_string(),
             start,
             absolute,
-            zone_s: tz_s,
+            zone: zone.cloned(),
             step,
             values: SeriesValues::Hz(hz),
+            notes: Vec::new(),
         }])
     }
 }
@@ -350,8 +396,10 @@ pub struct StoreBuild {
     pub inputs: Vec<String>,
     /// Grid name (default: `grid50` or `grid60` from the data).
     pub grid: Option<String>,
-    /// Zone of the local times in WAV names, seconds east of UTC.
-    pub tz_s: Option<f64>,
+    /// Zone of the local times in WAV names and in archives that carry none.
+    pub zone: Option<Zone>,
+    /// How grid archives are read (their zone is `zone`).
+    pub archive: ArchiveOptions,
     /// Start of the first trace CSV without its own, Unix seconds; each next one continues
     /// where the previous ended.
     pub start: Option<f64>,
@@ -370,6 +418,15 @@ pub struct GridBuilt {
     pub values: usize,
 }
 
+/// What a build did: the grids it changed, and what it read from each archive.
+#[derive(Debug, Clone)]
+pub struct StoreBuilt {
+    /// The grids changed.
+    pub grids: Vec<GridBuilt>,
+    /// Each archive read, with what was read and dropped.
+    pub archives: Vec<(PathBuf, crate::archive::ImportReport)>,
+}
+
 /// Adds the references of `build` to the store at `store` (created when missing): one series
 /// per grid, new values replace old, gaps stay gaps. The whole read-merge-write holds the
 /// store's lock; `on_wait` is called when another build holds it and this one waits.
@@ -378,7 +435,7 @@ pub fn build_store(
     build: &StoreBuild,
     progress: &Progress,
     on_wait: impl FnOnce(),
-) -> Result<Vec<GridBuilt>> {
+) -> Result<StoreBuilt> {
     if let Some(g) = &build.grid {
         check_grid_name(g)?;
     }
@@ -407,10 +464,28 @@ pub fn build_store(
     let bar = progress.steps(files.len() as u64, "adding references");
     let mut series: Vec<RefSeries> = Vec::new();
     let mut next_start = build.start;
+    let mut archives = Vec::new();
     for (path, at) in &files {
-        let (start, trace) = if is_wav(path) {
+        let (start, step, values, f0) = if is_wav(path) {
             let trace = reference_file(path, Nominal::Auto, &EnfParams::default())?;
-            (at.unwrap_or(wav_start(path, build.tz_s)?), trace)
+            let start = match at {
+                Some(t) => *t,
+                None => wav_start(path, build.zone.as_ref())?,
+            };
+            let f0 = nominal_of(&trace, path)?;
+            (start, trace.step_s, trace.enf_hz, f0)
+        } else if at.is_none() && crate::archive::is_archive(path) {
+            let opts = ArchiveOptions {
+                zone: build.zone.clone(),
+                ..build.archive.clone()
+            };
+            let ArchiveImport {
+                steps,
+                nominal_hz,
+                report,
+            } = crate::archive::import(path, &opts, None)?;
+            archives.push((path.clone(), report));
+            (steps.start, steps.step, steps.values, nominal_hz)
         } else {
             let trace = read_series(path, build.index_step_s)?;
             let start = at.or(next_start).with_context(|| {
@@ -419,11 +494,11 @@ pub fn build_store(
                     path.display()
                 )
             })?;
-            (start, trace)
+            let f0 = nominal_of(&trace, path)?;
+            (start, trace.step_s, trace.enf_hz, f0)
         };
-        let (step, values) = (trace.step_s, &trace.enf_hz);
+        let values = &values;
         next_start = Some(start + values.len() as f64 * step);
-        let f0 = nominal_of(&trace, path)?;
         let grid = build
             .grid
             .clone()
@@ -461,7 +536,10 @@ pub fn build_store(
             values: s.values.len(),
         });
     }
-    Ok(built)
+    Ok(StoreBuilt {
+        grids: built,
+        archives,
+    })
 }
 
 /// A trace CSV (`time_s,enf_hz`) or, with `index_step_s`, an `index,value` CSV.
@@ -469,7 +547,11 @@ fn read_series(path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
     let text = crate::trace::read_text(path)?;
     let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
     if index_step_s.is_none() && !header.contains("time_s") {
-        bail!("{}: an index CSV needs --step", path.display());
+        bail!(
+            "{}: neither an eenf trace (time_s,enf_hz) nor a grid archive (dates or Unix times \
+             and frequencies): an index,value CSV needs --index-step (seconds between values)",
+            path.display()
+        );
     }
     Trace::parse(&text, path, index_step_s)
 }

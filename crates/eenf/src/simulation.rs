@@ -559,7 +559,7 @@ pub fn recipe_timeline(r: &Recipe) -> Result<(EnfTimeline, f64, f64)> {
                 ReferenceSource::Wav(_) => EnfTimeline::wav(path, t0)?,
                 ReferenceSource::Trace(_) => EnfTimeline::trace(path, *index_step_s, t0)?,
                 _ => bail!(
-                    "{}: a folder, where a mains WAV or a trace file is needed",
+                    "{}: a mains WAV or a trace file is needed here (not a folder or a grid archive)",
                     path.display()
                 ),
             };

@@ -1,9 +1,11 @@
-//! Time: absolute instants (Unix seconds, UTC strings), UTC offsets, and the local wall-clock
-//! times that EV-ENFD file names carry. Calendar arithmetic is jiff's.
+//! Time: absolute instants (Unix seconds, UTC strings), time zones (IANA names with their
+//! summer time, or fixed UTC offsets), and the local wall-clock times that file names and
+//! archives carry. Calendar arithmetic and the time zone database are jiff's (the system's
+//! zoneinfo, or the copy built in where a machine has none).
 
 use anyhow::{bail, Context, Result};
 use jiff::civil::{DateTime, Weekday};
-use jiff::tz::Offset;
+use jiff::tz::{AmbiguousOffset, Offset, TimeZone};
 use jiff::Timestamp;
 
 /// A local wall-clock time (no zone), to the second, as a file name states it.
@@ -99,6 +101,149 @@ impl LocalTime {
     }
 }
 
+/// A time zone: an IANA name (`Europe/Berlin`, whose offset follows summer time) or a fixed
+/// UTC offset (`+08:00`, `Z`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Zone(TimeZone);
+
+/// What a local wall-clock time is in a zone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LocalInstant {
+    /// One instant, Unix seconds.
+    Unique(f64),
+    /// A time the clocks passed twice (the hour repeated when summer time ends): the first
+    /// and the second passage, Unix seconds.
+    Repeated(f64, f64),
+    /// A time the clocks skipped (the hour missing when summer time starts).
+    Missing,
+}
+
+impl Zone {
+    /// UTC.
+    pub fn utc() -> Self {
+        Zone(TimeZone::UTC)
+    }
+
+    /// A fixed offset, seconds east of UTC.
+    pub fn fixed(seconds: f64) -> Result<Self> {
+        let s = seconds.round();
+        if s.is_nan() || s.abs() > 18.0 * 3600.0 {
+            bail!("{seconds} s: not a UTC offset (at most 18 hours)");
+        }
+        Ok(Zone(TimeZone::fixed(Offset::from_seconds(s as i32)?)))
+    }
+
+    /// `Z`, `UTC`, an offset (`+08:00`, `-0500`, `+8`) or an IANA name (`Europe/Berlin`,
+    /// `America/New_York`).
+    pub fn parse(s: &str) -> Result<Self> {
+        let s = s.trim();
+        if s.is_empty() || s == "Z" || s.eq_ignore_ascii_case("utc") {
+            return Ok(Zone::utc());
+        }
+        if s.starts_with(['+', '-']) {
+            return Zone::fixed(tz_offset(s)?);
+        }
+        match TimeZone::get(s) {
+            Ok(tz) => Ok(Zone(tz)),
+            Err(_) => bail!(
+                "{s:?}: not a time zone: give an IANA name (Europe/Berlin, America/New_York, \
+                 Asia/Shanghai), an offset (+08:00) or Z for UTC"
+            ),
+        }
+    }
+
+    /// Its name: the IANA name, `UTC`, or the offset (`+08:00`).
+    pub fn name(&self) -> String {
+        if let Some(n) = self.0.iana_name() {
+            return n.to_string();
+        }
+        let o = self.0.to_offset(Timestamp::UNIX_EPOCH).seconds();
+        if o == 0 {
+            "UTC".into()
+        } else {
+            offset_label(o as f64)
+        }
+    }
+
+    /// Whether its offset never changes (UTC or a fixed offset).
+    pub fn is_fixed(&self) -> bool {
+        self.0.iana_name().is_none() || self.0.iana_name() == Some("UTC")
+    }
+
+    /// Its offset at an instant, seconds east of UTC.
+    pub fn offset_at(&self, unix_s: f64) -> f64 {
+        self.0.to_offset(timestamp(unix_s)).seconds() as f64
+    }
+
+    /// The instant(s) of a wall-clock time given as seconds after 1970-01-01 00:00 of the
+    /// wall clock (see [`LocalTime::local_seconds`]).
+    pub fn instant(&self, local_seconds: i64) -> LocalInstant {
+        let dt = LocalTime::from_local_seconds(local_seconds).0;
+        let l = local_seconds as f64;
+        match self.0.to_ambiguous_timestamp(dt).offset() {
+            AmbiguousOffset::Unambiguous { offset } => {
+                LocalInstant::Unique(l - offset.seconds() as f64)
+            }
+            AmbiguousOffset::Fold { before, after } => {
+                LocalInstant::Repeated(l - before.seconds() as f64, l - after.seconds() as f64)
+            }
+            AmbiguousOffset::Gap { .. } => LocalInstant::Missing,
+        }
+    }
+
+    /// An instant as the wall-clock time of this zone with its offset:
+    /// `2022-08-17 16:10:00 +08:00`.
+    pub fn local(&self, unix_s: f64) -> String {
+        local(unix_s, self.offset_at(unix_s))
+    }
+}
+
+impl std::str::FromStr for Zone {
+    type Err = anyhow::Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Zone::parse(s)
+    }
+}
+
+fn timestamp(unix_s: f64) -> Timestamp {
+    let s = unix_s.floor().clamp(
+        Timestamp::MIN.as_second() as f64,
+        Timestamp::MAX.as_second() as f64,
+    );
+    Timestamp::from_second(s as i64).unwrap_or(Timestamp::UNIX_EPOCH)
+}
+
+/// `+08:00`, `-05:30`.
+fn offset_label(seconds: f64) -> String {
+    let minutes = (seconds / 60.0).round() as i64;
+    let sign = if minutes < 0 { '-' } else { '+' };
+    format!("{sign}{:02}:{:02}", minutes.abs() / 60, minutes.abs() % 60)
+}
+
+/// Days from 1970-01-01 to a date of the proleptic Gregorian calendar (no check that the
+/// date exists: callers check month and day). Cheap enough for every row of an archive.
+pub fn days_from_civil(year: i64, month: u32, day: u32) -> i64 {
+    // H. Hinnant's algorithm: years counted from March, in 400-year eras
+    let y = if month <= 2 { year - 1 } else { year };
+    let era = y.div_euclid(400);
+    let yoe = y - era * 400;
+    let m = month as i64;
+    let doy = (153 * (if m > 2 { m - 3 } else { m + 9 }) + 2) / 5 + day as i64 - 1;
+    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    era * 146_097 + doe - 719_468
+}
+
+/// Days in a month of a year.
+pub fn days_in_month(year: i64, month: u32) -> u32 {
+    match month {
+        1 | 3 | 5 | 7 | 8 | 10 | 12 => 31,
+        4 | 6 | 9 | 11 => 30,
+        2 if (year % 4 == 0 && year % 100 != 0) || year % 400 == 0 => 29,
+        2 => 28,
+        _ => 0,
+    }
+}
+
 /// Parses a time: Unix seconds (`1660723800`), or ISO 8601 / RFC 3339 with its UTC offset
 /// (`2022-08-17T16:10:00+08:00`, `2022-08-17T08:10:00Z`). A time without a zone is refused,
 /// never taken as UTC. Unix seconds.
@@ -162,13 +307,10 @@ pub fn offset_of(s: &str) -> Result<f64> {
 /// `2022-08-17 16:10:00 +08:00`.
 pub fn local(unix_s: f64, tz_s: f64) -> String {
     let shifted = utc(unix_s + tz_s);
-    let minutes = (tz_s / 60.0).round() as i64;
-    let sign = if minutes < 0 { '-' } else { '+' };
     format!(
-        "{} {sign}{:02}:{:02}",
+        "{} {}",
         shifted.trim_end_matches('Z').replace('T', " "),
-        minutes.abs() / 60,
-        minutes.abs() % 60
+        offset_label(tz_s)
     )
 }
 
@@ -220,6 +362,57 @@ mod tests {
     }
 
     #[test]
+    fn zones_follow_summer_time() {
+        let berlin = Zone::parse("Europe/Berlin").unwrap();
+        assert_eq!(berlin.name(), "Europe/Berlin");
+        assert!(!berlin.is_fixed());
+        let at = |y, mo, d, h, mi| LocalTime::new(y, mo, d, h, mi, 0).unwrap().local_seconds();
+        // CEST in August: 15:26:02 local is 13:26:02 UTC
+        let aug = at(2024, 8, 19, 15, 26) + 2;
+        assert_eq!(
+            berlin.instant(aug),
+            LocalInstant::Unique(parse_time("2024-08-19T13:26:02Z").unwrap())
+        );
+        assert_eq!(
+            berlin.offset_at(parse_time("2024-01-10T12:00:00Z").unwrap()),
+            3600.0
+        );
+        // 2024-03-31 02:30 does not exist; 2024-10-27 02:30 happens twice, an hour apart
+        assert_eq!(
+            berlin.instant(at(2024, 3, 31, 2, 30)),
+            LocalInstant::Missing
+        );
+        assert_eq!(
+            berlin.instant(at(2024, 10, 27, 2, 30)),
+            LocalInstant::Repeated(
+                parse_time("2024-10-27T00:30:00Z").unwrap(),
+                parse_time("2024-10-27T01:30:00Z").unwrap()
+            )
+        );
+        assert_eq!(
+            berlin.local(parse_time("2024-10-27T01:30:00Z").unwrap()),
+            "2024-10-27 02:30:00 +01:00"
+        );
+        let ny = Zone::parse("America/New_York").unwrap();
+        assert_eq!(
+            ny.offset_at(parse_time("2022-08-01T00:00:00Z").unwrap()),
+            -4.0 * 3600.0
+        );
+        for (s, name) in [
+            ("+08:00", "+08:00"),
+            ("Z", "UTC"),
+            ("utc", "UTC"),
+            ("-0530", "-05:30"),
+        ] {
+            let z = Zone::parse(s).unwrap();
+            assert!(z.is_fixed());
+            assert_eq!(z.name(), name, "{s}");
+        }
+        let e = Zone::parse("Mars/Olympus").unwrap_err().to_string();
+        assert!(e.contains("IANA"), "{e}");
+    }
+
+    #[test]
     fn civil_days() {
         let day = |y, m, d| LocalTime::new(y, m, d, 0, 0, 0).unwrap().local_seconds() / 86_400;
         assert_eq!(day(1970, 1, 1), 0);
@@ -231,5 +424,26 @@ mod tests {
             (2, 29, 1, 1)
         );
         assert_eq!(leap.weekday(), "Thu");
+        for (y, m, d) in [
+            (1970, 1, 1),
+            (2022, 8, 17),
+            (2000, 3, 1),
+            (2024, 2, 29),
+            (1969, 12, 31),
+        ] {
+            assert_eq!(
+                days_from_civil(y as i64, m, d),
+                day(y, m as i8, d as i8),
+                "{y}-{m}-{d}"
+            );
+        }
+        assert_eq!(
+            (
+                days_in_month(2024, 2),
+                days_in_month(1900, 2),
+                days_in_month(2000, 2)
+            ),
+            (29, 28, 29)
+        );
     }
 }

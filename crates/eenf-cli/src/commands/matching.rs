@@ -7,9 +7,8 @@ use anyhow::Result;
 use eenf::locate::locate;
 use eenf::progress::Progress;
 use eenf::reference::ReferenceSeries;
-use eenf::time::tz_offset;
 use eenf::trace::Trace;
-use eenf_dsp::matching::resample;
+use eenf_dsp::resample::resample;
 
 use crate::args::MatchArgs;
 
@@ -34,9 +33,20 @@ pub struct Args {
 /// Runs `eenf match`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let trace = Trace::read(&a.trace, None)?;
-    let tz = a.search.tz.as_deref().map(tz_offset).transpose()?;
     let query = a.search.query();
-    let located = locate(&trace, &a.trace, &a.reference, tz, &query, &progress)?;
+    let located = locate(
+        &trace,
+        &a.trace,
+        &a.reference,
+        a.search.tz.as_ref(),
+        &query,
+        &progress,
+    )?;
+    for r in &located.references {
+        for n in &r.notes {
+            eprintln!("{n}");
+        }
+    }
     let (report, refs) = (&located.report, &located.references);
     let nominal = report.nominal_hz;
     let rows: Vec<_> = report

@@ -1,0 +1,235 @@
+//! Resampling onto a regular grid of steps, one way for every series eenf reads: the value of
+//! a step is the mean of the samples within half a step of its time (a finer series is
+//! averaged, never picked from), and a coarser series is interpolated linearly between two
+//! samples no farther apart than the caller allows. Gaps stay gaps.
+//!
+//! Steps sit on a grid anchored at time 0 (for absolute times, the Unix epoch), so that two
+//! files of one archive fall on the same steps.
+
+/// Accumulates samples `(time, value)` in any order into steps of `step` seconds.
+#[derive(Debug, Clone)]
+pub struct StepAverager {
+    step: f64,
+    /// Index (time / step) of `sums[0]`.
+    first: i64,
+    sums: Vec<f64>,
+    counts: Vec<u32>,
+    max_steps: usize,
+}
+
+/// A regular series: `values[i]` is the value at `start + i·step` (NaN: no value).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Steps {
+    /// Time of the first value, s.
+    pub start: f64,
+    /// Seconds between values.
+    pub step: f64,
+    /// The values; NaN marks a gap.
+    pub values: Vec<f64>,
+}
+
+impl StepAverager {
+    /// An empty accumulator of `step`-second steps that refuses samples that would make it
+    /// span more than `max_steps` steps (a wild time must not become a huge allocation).
+    pub fn new(step: f64, max_steps: usize) -> Self {
+        assert!(step > 0.0 && step.is_finite(), "a positive step");
+        StepAverager {
+            step,
+            first: 0,
+            sums: Vec::new(),
+            counts: Vec::new(),
+            max_steps,
+        }
+    }
+
+    /// The step, s.
+    pub fn step(&self) -> f64 {
+        self.step
+    }
+
+    /// The index of the step whose half-open span `[t − step/2, t + step/2)` holds `time`.
+    pub fn index(&self, time: f64) -> i64 {
+        // the small bias keeps 0.1·k samples on the side of the step they name
+        (time / self.step + 0.5 + 1e-9).floor() as i64
+    }
+
+    /// Adds a sample. A value that is not finite is ignored; `false` when its time lies so
+    /// far from the others that the series would exceed its bound (it is not added).
+    pub fn push(&mut self, time: f64, value: f64) -> bool {
+        if !time.is_finite() {
+            return false;
+        }
+        if !value.is_finite() {
+            return true;
+        }
+        let k = self.index(time);
+        if self.sums.is_empty() {
+            self.first = k;
+        }
+        if k < self.first {
+            let grow = (self.first - k) as u64;
+            if grow + self.sums.len() as u64 > self.max_steps as u64 {
+                return false;
+            }
+            // grow the front by at least what is there, so reversed input stays linear
+            let room = self.max_steps - self.sums.len();
+            let pad = (grow as usize).max(self.sums.len().min(room));
+            let mut sums = vec![0.0; pad];
+            sums.extend_from_slice(&self.sums);
+            let mut counts = vec![0; pad];
+            counts.extend_from_slice(&self.counts);
+            self.sums = sums;
+            self.counts = counts;
+            self.first -= pad as i64;
+        }
+        let i = (k - self.first) as u64;
+        if i >= self.max_steps as u64 {
+            return false;
+        }
+        let i = i as usize;
+        if i >= self.sums.len() {
+            self.sums.resize(i + 1, 0.0);
+            self.counts.resize(i + 1, 0);
+        }
+        self.sums[i] += value;
+        self.counts[i] = self.counts[i].saturating_add(1);
+        true
+    }
+
+    /// Number of samples added.
+    pub fn samples(&self) -> u64 {
+        self.counts.iter().map(|&c| c as u64).sum()
+    }
+
+    /// The series from the first step with a value to the last. Steps without a sample that
+    /// lie between two with samples at most `interpolate_s` seconds apart are interpolated
+    /// linearly (a series coarser than the step); other empty steps are gaps.
+    pub fn finish(self, interpolate_s: f64) -> Steps {
+        let filled: Vec<usize> = (0..self.counts.len())
+            .filter(|&i| self.counts[i] > 0)
+            .collect();
+        let (Some(&a), Some(&b)) = (filled.first(), filled.last()) else {
+            return Steps {
+                start: 0.0,
+                step: self.step,
+                values: Vec::new(),
+            };
+        };
+        let mut values: Vec<f64> = (a..=b)
+            .map(|i| {
+                if self.counts[i] > 0 {
+                    self.sums[i] / self.counts[i] as f64
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect();
+        let reach = (interpolate_s / self.step + 1e-9).floor() as usize;
+        if reach >= 2 {
+            for w in filled.windows(2) {
+                let (p, q) = (w[0] - a, w[1] - a);
+                if q - p >= 2 && q - p <= reach {
+                    let (vp, vq) = (values[p], values[q]);
+                    for (j, v) in values[p + 1..q].iter_mut().enumerate() {
+                        let f = (j + 1) as f64 / (q - p) as f64;
+                        *v = vp + (vq - vp) * f;
+                    }
+                }
+            }
+        }
+        Steps {
+            start: (self.first + a as i64) as f64 * self.step,
+            step: self.step,
+            values,
+        }
+    }
+}
+
+/// Resamples a regular series from `from_step` to `to_step` seconds: value `j` is at
+/// `j·to_step` from the first value. Finer to coarser averages the samples within half a step;
+/// coarser to finer interpolates between neighbouring samples. NaN marks gaps, in and out.
+pub fn resample(x: &[f64], from_step: f64, to_step: f64) -> Vec<f64> {
+    if (from_step - to_step).abs() < 1e-9 || x.len() < 2 {
+        return x.to_vec();
+    }
+    let span = (x.len() - 1) as f64 * from_step;
+    let n = (span / to_step + 1e-9).floor() as usize + 1;
+    let mut acc = StepAverager::new(to_step, n + 1);
+    for (i, &v) in x.iter().enumerate() {
+        acc.push(i as f64 * from_step, v);
+    }
+    // neighbouring samples only: a NaN between two values leaves a gap
+    let s = acc.finish(from_step * 1.5);
+    if s.values.is_empty() {
+        return vec![f64::NAN; n];
+    }
+    let lead = (s.start / to_step).round() as usize;
+    let mut out = vec![f64::NAN; n];
+    for (j, v) in s.values.iter().enumerate() {
+        if let Some(slot) = out.get_mut(lead + j) {
+            *slot = *v;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn finer_series_are_averaged_not_picked() {
+        // 0.1 s samples of a ramp: each second is the mean of the ten samples around it
+        let x: Vec<f64> = (0..50).map(|i| i as f64).collect();
+        let y = resample(&x, 0.1, 1.0);
+        assert_eq!(y.len(), 5);
+        // second 0 holds samples 0..=4 (the half step before it is not there)
+        assert!((y[0] - 2.0).abs() < 1e-12, "{y:?}");
+        for (j, v) in y.iter().enumerate().skip(1).take(3) {
+            assert!((v - 10.0 * j as f64 + 0.5).abs() < 1e-9, "{j}: {v}");
+        }
+        // a sample picker would give 10, 20, 30 here: a 1 s step of a 10 Hz alternation
+        // averages to the middle instead of aliasing
+        let alt: Vec<f64> = (0..100)
+            .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
+        let y = resample(&alt, 0.1, 1.0);
+        assert!(y[1..9].iter().all(|v| v.abs() < 1e-12), "{y:?}");
+    }
+
+    #[test]
+    fn coarser_series_are_interpolated_and_gaps_kept() {
+        assert_eq!(
+            resample(&[0.0, 2.0, 4.0], 2.0, 1.0),
+            vec![0.0, 1.0, 2.0, 3.0, 4.0]
+        );
+        let y = resample(&[0.0, f64::NAN, 4.0, 6.0], 2.0, 1.0);
+        assert_eq!(y[0], 0.0);
+        assert!(y[1..4].iter().all(|v| v.is_nan()), "{y:?}");
+        assert_eq!(&y[4..], &[4.0, 5.0, 6.0]);
+    }
+
+    #[test]
+    fn samples_in_any_order_and_repeats_are_merged() {
+        let mut a = StepAverager::new(1.0, 1000);
+        for (t, v) in [
+            (105.0, 5.0),
+            (100.0, 1.0),
+            (100.2, 3.0),
+            (103.0, f64::NAN),
+            (101.0, 2.0),
+        ] {
+            assert!(a.push(t, v));
+        }
+        // a time far outside the bound is refused, not allocated
+        assert!(!a.push(1e12, 1.0));
+        assert!(!a.push(-1e12, 1.0));
+        assert_eq!(a.samples(), 4);
+        let s = a.finish(0.0);
+        assert_eq!(s.start, 100.0);
+        assert_eq!(s.values.len(), 6);
+        assert_eq!((s.values[0], s.values[1]), (2.0, 2.0));
+        assert!(s.values[2].is_nan() && s.values[3].is_nan() && s.values[4].is_nan());
+        assert_eq!(s.values[5], 5.0);
+    }
+}
