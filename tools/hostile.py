@@ -1,19 +1,55 @@
 #!/usr/bin/env python3
 """Every file of ../shared/fixtures/hostile through the commands its README names, under the
 limits of the issue that collected them (`ulimit -v 4000000`, 20 s, 200 MB peak): an error
-or a warning is fine; a panic, abort, signal, hang or overrun is not.
+or a warning is fine; a panic, abort, signal, hang or overrun is not. Every file also goes to
+`refdb build` (which sniffs grid archives), with damaged archives written here: truncated and
+bombed zips, a truncated gzip, a line without end, wild and far-apart dates.
 
     tools/hostile.py EENF_BINARY HOSTILE_DIR ENF_REFERENCE_DIR
 """
+import gzip
+import io
 import os
 import shutil
 import sys
 import tempfile
+import zipfile
 
 sys.path.insert(0, os.path.dirname(__file__))
 import sweep  # noqa: E402
 
 sweep.LIMIT_AS = 4_000_000 * 1024
+
+
+def damaged_archives(work):
+    """Grid archives with the faults a download or a disk gives them."""
+    d = os.path.join(work, "archives")
+    os.makedirs(d)
+    day = "Time,Value\n" + "".join(
+        f"2023-06-01 00:{m:02}:{s:02}.{t}00,{50 + 0.001 * (s % 9):.3f}\n"
+        for m in range(60) for s in range(60) for t in range(0, 10, 5))
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("2023-06-01.csv", day)
+        z.writestr("2023-06-02.csv", day.replace("2023-06-01", "2023-06-02"))
+    whole = buf.getvalue()
+    files = {
+        "zip_truncated.zip": whole[: len(whole) // 2],
+        "zip_flipped.zip": whole[:200] + bytes(b ^ 0x5A for b in whole[200:400]) + whole[400:],
+        "gzip_truncated.csv.gz": gzip.compress(day.encode())[:5000],
+        "line_without_end.csv": b"dtm,f\n2022-08-17 08:00:00," + b"9" * 5_000_000,
+        "wild_dates.csv": ("dtm,f\n2022-08-17 08:00:00,50.01\n2099-12-31 23:59:59,50.0\n"
+                           "1971-01-01 00:00:00,50.0\n2031-01-01 00:00:00,50.02\n"
+                           "2022-08-17 08:00:01,0\n").encode(),
+    }
+    bomb = io.BytesIO()
+    with zipfile.ZipFile(bomb, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("2023-06-03.csv", "Time,Value\n" + "2023-06-03 00:00:00.000,50.000\n" * 3_000_000)
+    files["zip_bomb_repeated_rows.zip"] = bomb.getvalue()
+    for name, data in files.items():
+        with open(os.path.join(d, name), "wb") as f:
+            f.write(data)
+    return d
 
 
 def main():
@@ -47,9 +83,18 @@ def main():
             path = store
         else:
             continue
+        if not os.path.isdir(path):
+            # anything may be handed to refdb build as an archive
+            cmds["refdb-archive"] = ["refdb", "build", os.path.join(work, "archive-store"),
+                                     "--tz", "Z", "{}"]
         for key, argv in cmds.items():
             commands[f"{key}:{name}"] = argv
             runs.append((name, f"{key}:{name}", path))
+    archives = damaged_archives(work)
+    for name in sorted(os.listdir(archives)):
+        key = f"refdb-archive:{name}"
+        commands[key] = ["refdb", "build", os.path.join(work, "archive-store"), "--tz", "Z", "{}"]
+        runs.append((name, key, os.path.join(archives, name)))
     sweep.COMMANDS = commands
     bad = []
     for name, key, path in runs:

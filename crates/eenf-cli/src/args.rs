@@ -7,6 +7,7 @@ use std::str::FromStr;
 
 use anyhow::{bail, Context, Result};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
+use eenf::archive::{ArchiveFormat, ArchiveOptions, DateOrder, ValueUnit};
 use eenf::edits::{EditInput, EditOptions, EditParams};
 use eenf::extract::ExtractOptions;
 use eenf::simulation::{EnfSource, Recipe};
@@ -739,5 +740,68 @@ impl EditArgs {
                 ..ExtractOptions::default()
             },
         }
+    }
+}
+
+/// How `refdb build` reads its inputs and where their values go (also the Python package's
+/// `refdb_build` keywords).
+#[derive(Debug, Clone, clap::Args)]
+pub struct StoreInputArgs {
+    /// Grid name (default: `grid50` or `grid60` from the data).
+    #[arg(long)]
+    pub grid: Option<String>,
+    /// Zone of local times (in WAV names and in archives whose times carry none): an IANA
+    /// name (Europe/Berlin, America/New_York; summer time followed) or a UTC offset (+08:00,
+    /// Z). Local times need it: none is assumed.
+    #[arg(long, allow_hyphen_values = true)]
+    pub tz: Option<Zone>,
+    /// Layout of grid archives: auto (sniffed from the header and first rows), ngeso (UK,
+    /// `dtm,f`, UTC), fingrid (Finland, `Time,Value`, 0.1 s), transnetbw (Germany,
+    /// `DD.MM.YYYY HH:MM:SS`), osf (`year;month;day;hour;minute;second;value`, UTC).
+    #[arg(long, default_value = "auto", value_parser = one_of::<ArchiveFormat>(&ArchiveFormat::NAMES))]
+    pub format: ArchiveFormat,
+    /// What an archive's value column holds: auto (Hz when near 50 or 60; a deviation when
+    /// the header says so), hz, mhz-deviation or hz-deviation.
+    #[arg(long, default_value = "auto", value_parser = one_of::<ValueUnit>(&ValueUnit::NAMES))]
+    pub value_unit: ValueUnit,
+    /// The order of day and month in an archive's dates like 05/06/2022: auto, dmy or mdy.
+    #[arg(long, default_value = "auto", value_parser = one_of::<DateOrder>(&DateOrder::NAMES))]
+    pub date_order: DateOrder,
+    /// Nominal grid frequency of archives that give deviations: 50 or 60.
+    #[arg(long, value_parser = number_in(40.0, 70.0))]
+    pub nominal: Option<f64>,
+    /// Start time of the first trace CSV (UTC, or with an offset).
+    #[arg(long)]
+    pub start: Option<String>,
+    /// Fail at once when another build is changing the store, instead of waiting for it.
+    #[arg(long)]
+    pub no_wait: bool,
+    /// Seconds between values of `index,value` CSVs.
+    #[arg(long, alias = "step", value_parser = number_in(0.001, 3600.0))]
+    pub index_step: Option<f64>,
+}
+
+impl StoreInputArgs {
+    /// The build of `inputs`, as the library takes it.
+    pub fn build(&self, inputs: Vec<String>) -> Result<eenf::reference::StoreBuild> {
+        Ok(eenf::reference::StoreBuild {
+            inputs,
+            grid: self.grid.clone(),
+            zone: self.tz.clone(),
+            archive: ArchiveOptions {
+                format: self.format,
+                zone: None,
+                unit: self.value_unit,
+                date_order: self.date_order,
+                nominal_hz: self.nominal,
+            },
+            start: self
+                .start
+                .as_deref()
+                .map(eenf::time::parse_time)
+                .transpose()?,
+            index_step_s: self.index_step,
+            wait: !self.no_wait,
+        })
     }
 }

@@ -207,6 +207,28 @@ fn zip_7z_and_gzip_archives_give_the_same_seconds() {
     for other in &stores[1..] {
         assert_eq!(other.values, s.values);
     }
+    // a download cut short (no directory at the end): the whole first day is kept, with a warning
+    let whole = std::fs::read(d.join("month.zip")).unwrap();
+    std::fs::write(d.join("cut.zip"), &whole[..whole.len() * 3 / 4]).unwrap();
+    let (_, said) = ok(
+        &["refdb", "build", "cut", "cut.zip", "--format", "fingrid"],
+        d,
+    );
+    assert!(
+        said.contains("warning") && said.contains("damaged zip"),
+        "{said}"
+    );
+    let cut = RefSeries::load(&d.join("cut"), "grid50").unwrap();
+    assert!(cut.values.len() >= 300, "{}", cut.values.len());
+    assert_eq!(cut.values[..300], s.values[..300]);
+    // a 7z keeps its directory at the end: cut short, it is refused in one line
+    let whole = std::fs::read(d.join("month.7z")).unwrap();
+    std::fs::write(d.join("cut.7z"), &whole[..whole.len() * 3 / 4]).unwrap();
+    let e = refused(
+        &["refdb", "build", "cut7", "cut.7z", "--format", "fingrid"],
+        d,
+    );
+    assert!(e.contains("cut.7z") && e.contains("7z"), "{e}");
 }
 
 #[test]

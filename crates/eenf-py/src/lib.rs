@@ -20,7 +20,7 @@ use eenf::recording::Recording;
 use eenf::trace::Trace;
 use eenf_cli::args::{
     AudioArgs, EditArgs, EventOutputArgs, InputArgs, MatchArgs, MethodArgs, SimulateArgs,
-    TrackerArgs, VideoMethodArgs,
+    StoreInputArgs, TrackerArgs, VideoMethodArgs,
 };
 use eenf_core::Nominal;
 use eenf_events::{EventBatch, EventReader};
@@ -118,6 +118,7 @@ fn option_set(what: &str) -> PyResult<clap::Command> {
         "match" => MatchArgs::augment_args(c),
         "write" => EventOutputArgs::augment_args(c),
         "edits" => EditArgs::augment_args(c),
+        "refdb_build" => StoreInputArgs::augment_args(c),
         _ => return Err(PyValueError::new_err(format!("no option set {what:?}"))),
     })
 }
@@ -624,6 +625,36 @@ fn match_trace(
     .map_err(py_err)
 }
 
+/// `eenf refdb build`: adds grid archives, hourly mains WAVs or trace files to the store at
+/// `store` (created when missing); returns the grids changed and what each archive gave, as
+/// JSON text. The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (store, inputs, argv=Vec::new()))]
+fn refdb_build(
+    py: Python<'_>,
+    store: PathBuf,
+    inputs: Vec<String>,
+    argv: Vec<String>,
+) -> PyResult<String> {
+    let a: StoreInputArgs = parse("refdb_build", argv)?;
+    let build = a.build(inputs).map_err(py_err)?;
+    py.detach(|| {
+        let built = eenf::reference::build_store(&store, &build, &Progress::hidden(), || {})?;
+        let grids: Vec<_> = built
+            .grids
+            .iter()
+            .map(|g| serde_json::json!({"grid": g.grid, "values": g.values}))
+            .collect();
+        let archives: Vec<_> = built
+            .archives
+            .iter()
+            .map(|(p, r)| serde_json::json!({"path": p, "summary": r.to_string(), "report": r}))
+            .collect();
+        Ok(serde_json::json!({"store": store, "grids": grids, "archives": archives}).to_string())
+    })
+    .map_err(py_err)
+}
+
 /// `eenf simulate`: writes a recording and its truth; returns what was written, as JSON text.
 /// The GIL is released.
 #[pyfunction]
@@ -760,6 +791,7 @@ fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(match_trace, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(refdb_build, m)?)?;
     m.add_function(wrap_pyfunction!(write_events, m)?)?;
     m.add_function(wrap_pyfunction!(edits, m)?)?;
     m.add_function(wrap_pyfunction!(edits_samples, m)?)?;

@@ -11,7 +11,7 @@ STUB = Path(eenf.__file__).with_name("__init__.pyi")
 SETS = {"read_events": ["input"], "iter_events": ["input"], "info": ["input"],
         "extract": ["extract"], "reference": ["reference"], "video": ["video"],
         "match": ["match"], "simulate": ["simulate"], "write_events": ["write"],
-        "edits": ["edits"]}
+        "edits": ["edits"], "refdb_build": ["refdb_build"]}
 
 
 def stub_functions():

@@ -37,6 +37,8 @@ const SNIFF_ROWS: usize = 64;
 const PLAUSIBLE_HZ: f64 = 2.5;
 /// Longest span one input may cover (bounds the memory of its steps, 12 bytes each).
 const MAX_SPAN_S: f64 = 400.0 * 86_400.0;
+/// The coarsest step an archive may have, s.
+const MAX_STEP_S: f64 = 60.0;
 /// Years an archive's dates may name.
 const YEARS: std::ops::RangeInclusive<i64> = 1970..=2100;
 
@@ -348,7 +350,17 @@ pub fn import(path: &Path, opts: &ArchiveOptions, step_s: Option<f64>) -> Result
             Some(m) => format!("{name} ({m})"),
             None => name.clone(),
         };
-        let lines = first_lines(reader, SNIFF_ROWS).with_context(|| label.clone())?;
+        let lines = match first_lines(reader, SNIFF_ROWS) {
+            Ok(l) => l,
+            // a damaged member after good ones: what came before is kept
+            Err(e) if state.is_some() => {
+                report
+                    .warnings
+                    .push(format!("{label}: {e}; the members before it are kept"));
+                return Ok(());
+            }
+            Err(e) => return Err(e.context(label)),
+        };
         if lines.is_empty() {
             report.warnings.push(format!("{label}: empty"));
             return Ok(());
@@ -483,8 +495,11 @@ fn for_each_member(path: &Path, each: &mut MemberFn<'_>) -> Result<Vec<String>> 
             each(None, &mut BufReader::new(gz))?;
         }
         Container::Zip => {
-            let mut zip = zip::ZipArchive::new(BufReader::new(open()?))
-                .map_err(|e| anyhow::anyhow!("{name}: not a readable zip archive: {e}"))?;
+            let mut zip = match zip::ZipArchive::new(BufReader::new(open()?)) {
+                Ok(z) => z,
+                // no directory at the end (a download cut short): the members in order
+                Err(e) => return zip_in_order(path, each, e),
+            };
             let mut names: Vec<String> = zip
                 .file_names()
                 .filter_map(|n| n.ok().map(|n| n.into_owned()))
@@ -551,6 +566,43 @@ fn for_each_member(path: &Path, each: &mut MemberFn<'_>) -> Result<Vec<String>> 
                 bail!("{name}: a 7z archive with no CSV or text table in it");
             }
         }
+    }
+    Ok(warnings)
+}
+
+/// The members of a zip whose central directory cannot be read, in the order they are stored,
+/// up to the damage (a cut-short download keeps its first days).
+fn zip_in_order(
+    path: &Path,
+    each: &mut MemberFn<'_>,
+    why: zip::result::ZipError,
+) -> Result<Vec<String>> {
+    let name = path.display();
+    let mut r = BufReader::new(File::open(path).with_context(|| format!("{name}"))?);
+    let mut tables = 0usize;
+    let mut warnings = Vec::new();
+    loop {
+        match zip::read::read_zipfile_from_stream(&mut r) {
+            Ok(Some(entry)) => {
+                let member = entry.name().map(|n| n.into_owned()).unwrap_or_default();
+                if is_table(&member) {
+                    tables += 1;
+                    each(Some(&member), &mut BufReader::new(entry))?;
+                }
+            }
+            Ok(None) => break,
+            Err(e) => {
+                if tables > 0 {
+                    warnings.push(format!(
+                        "{name}: a damaged zip archive ({why}; then {e}): the members before the damage are kept"
+                    ));
+                }
+                break;
+            }
+        }
+    }
+    if tables == 0 {
+        bail!("{name}: not a readable zip archive ({why}), and no whole table at its start");
     }
     Ok(warnings)
 }
@@ -696,6 +748,7 @@ impl Layout {
         match &self.zone {
             ZoneRule::InRows => "with their own UTC offsets".into(),
             ZoneRule::Utc(why) => format!("in {why}"),
+            ZoneRule::Given(z) if z.name() == "UTC" => "in UTC (--tz)".into(),
             ZoneRule::Given(z) => format!("local to {} (--tz)", z.name()),
         }
     }
@@ -780,9 +833,12 @@ impl Layout {
             .map(|w| w[1] - w[0])
             .filter(|d| *d > 1e-6)
             .collect();
+        // an archive steps by 0.1 s to a minute: wild rows among the first must not make a
+        // step of years
         median(diffs)
             .filter(|d| d.is_finite() && *d > 0.0)
             .unwrap_or(1.0)
+            .clamp(0.001, MAX_STEP_S)
     }
 }
 

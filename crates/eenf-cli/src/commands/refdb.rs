@@ -3,13 +3,12 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
-use eenf::archive::{ArchiveFormat, ArchiveOptions, DateOrder, ValueUnit};
 use eenf::progress::Progress;
 use eenf::refdb::{RefSeries, StoreLock, GAP};
-use eenf::reference::{build_store, StoreBuild};
-use eenf::time::{parse_time, utc, Zone};
+use eenf::reference::build_store;
+use eenf::time::{utc, Zone};
 
-use crate::args::one_of;
+use crate::args::StoreInputArgs;
 
 /// `eenf refdb` subcommands.
 #[derive(Debug, clap::Subcommand)]
@@ -41,61 +40,13 @@ pub struct BuildArgs {
     /// one continues where the previous ended.
     #[arg(required = true)]
     pub inputs: Vec<String>,
-    /// Grid name (default: `grid50` or `grid60` from the data).
-    #[arg(long)]
-    pub grid: Option<String>,
-    /// Zone of local times (in WAV names and in archives whose times carry none): an IANA
-    /// name (Europe/Berlin, America/New_York; summer time followed) or a UTC offset (+08:00,
-    /// Z). Local times need it: none is assumed.
-    #[arg(long, allow_hyphen_values = true)]
-    pub tz: Option<Zone>,
-    /// Layout of grid archives: auto (sniffed from the header and first rows), ngeso (UK,
-    /// `dtm,f`, UTC), fingrid (Finland, `Time,Value`, 0.1 s), transnetbw (Germany,
-    /// `DD.MM.YYYY HH:MM:SS`), osf (`year;month;day;hour;minute;second;value`, UTC).
-    #[arg(long, default_value = "auto", value_parser = one_of::<ArchiveFormat>(&ArchiveFormat::NAMES))]
-    pub format: ArchiveFormat,
-    /// What an archive's value column holds: auto (Hz when near 50 or 60; a deviation when
-    /// the header says so), hz, mhz-deviation or hz-deviation.
-    #[arg(long, default_value = "auto", value_parser = one_of::<ValueUnit>(&ValueUnit::NAMES))]
-    pub value_unit: ValueUnit,
-    /// The order of day and month in an archive's dates like 05/06/2022: auto, dmy or mdy.
-    #[arg(long, default_value = "auto", value_parser = one_of::<DateOrder>(&DateOrder::NAMES))]
-    pub date_order: DateOrder,
-    /// Nominal grid frequency of archives that give deviations: 50 or 60.
-    #[arg(long, value_parser = crate::args::number_in(40.0, 70.0))]
-    pub nominal: Option<f64>,
-    /// Start time of the first trace CSV (UTC, or with an offset).
-    #[arg(long)]
-    pub start: Option<String>,
-    /// Fail at once when another build is changing the store, instead of waiting for it.
-    #[arg(long)]
-    pub no_wait: bool,
-    /// Seconds between values of `index,value` CSVs.
-    #[arg(long, alias = "step", value_parser = crate::args::number_in(0.001, 3600.0))]
-    pub index_step: Option<f64>,
-}
-
-/// What `refdb build` is asked to do, as the library takes it.
-pub fn store_build(a: &BuildArgs) -> Result<StoreBuild> {
-    Ok(StoreBuild {
-        inputs: a.inputs.clone(),
-        grid: a.grid.clone(),
-        zone: a.tz.clone(),
-        archive: ArchiveOptions {
-            format: a.format,
-            zone: None,
-            unit: a.value_unit,
-            date_order: a.date_order,
-            nominal_hz: a.nominal,
-        },
-        start: a.start.as_deref().map(parse_time).transpose()?,
-        index_step_s: a.index_step,
-        wait: !a.no_wait,
-    })
+    /// How the inputs are read and where they go.
+    #[command(flatten)]
+    pub how: StoreInputArgs,
 }
 
 fn build(a: BuildArgs, progress: Progress) -> Result<()> {
-    let build = store_build(&a)?;
+    let build = a.how.build(a.inputs.clone())?;
     let built = build_store(&a.store, &build, &progress, || {
         eprintln!(
             "{}: another build is changing this store; waiting for it",
@@ -116,7 +67,7 @@ fn build(a: BuildArgs, progress: Progress) -> Result<()> {
             g.values
         );
     }
-    info(&a.store, a.tz.as_ref())
+    info(&a.store, a.how.tz.as_ref())
 }
 
 fn info(store: &Path, zone: Option<&Zone>) -> Result<()> {
@@ -140,8 +91,8 @@ fn info(store: &Path, zone: Option<&Zone>) -> Result<()> {
         outln!("nominal     {} Hz", m.nominal_hz);
         outln!("step        {} s", m.step_s);
         let when = |t: f64| match zone {
-            Some(z) => format!("{}  ({})", utc(t), z.local(t)),
-            None => utc(t),
+            Some(z) if z.name() != "UTC" => format!("{}  ({})", utc(t), z.local(t)),
+            _ => utc(t),
         };
         outln!("from        {}", when(m.start_unix_s));
         outln!("to          {}", when(end));

@@ -57,6 +57,7 @@ __all__ = [
     "match",
     "simulate",
     "edits",
+    "refdb_build",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -518,6 +519,17 @@ def match(trace: Any, reference: PathLike, top: int = 5, **params: Any) -> Dict[
     )
 
 
+def refdb_build(store: PathLike, *inputs: PathLike, **params: Any) -> Dict[str, Any]:
+    """``eenf refdb build``: adds grid archives (operators' and measurement sites' frequency
+    CSVs, plain or in zip, 7z or gzip files), hourly mains WAVs or trace files to the store
+    ``store`` (created when missing). Local times need ``tz`` (``"Europe/Berlin"``,
+    ``"+08:00"``, ``"Z"``): none is assumed. Returns the ``grids`` changed (name, values) and,
+    for each archive, its ``summary`` and ``report`` (layout, zone, rows read and dropped)."""
+    return json.loads(
+        _eenf.refdb_build(os.fspath(store), [os.fspath(i) for i in inputs], _flags(params))
+    )
+
+
 class Simulation(NamedTuple):
     """What :func:`simulate` wrote."""
 
@@ -580,5 +592,6 @@ _document(reference, "reference")
 _document(video, "video")
 _document(match, "match")
 _document(simulate, "simulate")
+_document(refdb_build, "refdb_build")
 _document(write_events, "write")
 _document(edits, "edits")

@@ -196,6 +196,19 @@ def match(
     alpha: float = 0.001,
     tz: Optional[str] = None,
 ) -> Dict[str, Any]: ...
+def refdb_build(
+    store: PathLike,
+    *inputs: PathLike,
+    grid: Optional[str] = None,
+    tz: Optional[str] = None,
+    format: Literal["auto", "ngeso", "fingrid", "transnetbw", "osf"] = "auto",
+    value_unit: Literal["auto", "hz", "mhz-deviation", "hz-deviation"] = "auto",
+    date_order: Literal["auto", "dmy", "mdy"] = "auto",
+    nominal: Optional[float] = None,
+    start: Optional[str] = None,
+    no_wait: bool = False,
+    index_step: Optional[float] = None,
+) -> Dict[str, Any]: ...
 def simulate(
     output: Optional[PathLike] = None,
     *,
