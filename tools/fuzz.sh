@@ -12,7 +12,7 @@ cd "$(dirname "$0")/../fuzz"
 secs=${1:?seconds per target}
 shift
 targets=("$@")
-((${#targets[@]})) || targets=(aedat4 evt2 evt21 evt3 dat aedat2 aedat31 text probe)
+((${#targets[@]})) || targets=(aedat4 evt2 evt21 evt3 dat aedat2 aedat31 text eventstream atis rosbag probe)
 shared=${EENF_SHARED:-$PWD/../../shared}
 command -v cargo-fuzz >/dev/null || cargo install --locked cargo-fuzz
 cargo fuzz build -s none -O >/dev/null
@@ -26,7 +26,7 @@ def text_header_end(b, prefix):
     while b.startswith(prefix, pos):
         pos = b.index(b"\n", pos) + 1
     return pos
-def seed(target, b):
+def seed(target, b, f=""):
     if target == "probe":
         return b
     if target == "aedat4":
@@ -45,13 +45,19 @@ def seed(target, b):
         return b[text_header_end(b, b"#"):] if b.startswith(b"#!AER-DAT2.0") else None
     if target == "aedat31":
         return b[b.index(b"#!END-HEADER\r\n") + 14:] if b.startswith(b"#!AER-DAT3") else None
+    if target == "eventstream":
+        return b[20:] if b.startswith(b"Event Stream") else None
+    if target == "rosbag":
+        return b[13:] if b.startswith(b"#ROSBAG V2.0") else None
+    if target == "atis":
+        return b if f.endswith(".bin") else None
     if target == "text":
         return b if b[:1].isdigit() or b[:1] == b"#" or b[:2] == b"t," else None
 for t in targets:
     os.makedirs(f"corpus/{t}", exist_ok=True)
     n = 0
     for f in files:
-        s = seed(t, open(f, "rb").read())
+        s = seed(t, open(f, "rb").read(), f)
         if s:
             open(f"corpus/{t}/seed_{os.path.basename(f)}", "wb").write(s[:65536])
             n += 1

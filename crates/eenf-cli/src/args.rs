@@ -161,6 +161,10 @@ pub struct InputArgs {
     /// backwards: a larger one (a corrupt timestamp) ends the usable stream there.
     #[arg(long, default_value_t = eenf_events::DEFAULT_MAX_GAP_US as f64 * 1e-6)]
     pub max_gap: f64,
+    /// The topic to read in a ROS bag (default: the first topic of event messages; `info`
+    /// lists them all).
+    #[arg(long)]
+    pub topic: Option<String>,
 }
 
 impl InputArgs {
@@ -172,6 +176,7 @@ impl InputArgs {
             strict: self.strict,
             // NaN and negatives: no step is allowed; huge values: any is
             max_gap_us: Some((self.max_gap * 1e6).clamp(0.0, i64::MAX as f64) as i64),
+            topic: self.topic.clone(),
         }
     }
 }

@@ -21,13 +21,16 @@
 #![deny(unsafe_code)]
 
 pub mod aedat4;
+pub mod atis;
 pub mod contain;
 mod error;
+pub mod eventstream;
 mod guard;
 pub mod jaer;
 pub mod memory;
 mod prefetch;
 pub mod prophesee;
+pub mod rosbag;
 mod stream;
 pub mod text;
 pub mod writers;
@@ -44,7 +47,7 @@ pub use memory::open_events;
 pub use text::TextReader;
 
 /// The formats this version reads, for error messages.
-pub const SUPPORTED: &str = "AEDAT 4.0 (.aedat4), Prophesee EVT 2.0/2.1/3.0 (.raw) and DAT (.dat), jAER AEDAT 2.0/3.1 (.aedat), text (t x y p)";
+pub const SUPPORTED: &str = "AEDAT 4.0 (.aedat4), Prophesee EVT 2.0/2.1/3.0 (.raw) and DAT (.dat), jAER AEDAT 2.0/3.1 (.aedat), ROS 1 bags of event messages (.bag), Event Stream 2 DVS (.es), ATIS .bin (N-MNIST, N-Caltech101), text (t x y p)";
 
 /// One data stream declared by a file (AEDAT4 files can carry events, frames, IMU, triggers).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -104,6 +107,9 @@ pub struct OpenOptions {
     /// The largest step of a timestamp between two events, µs, forwards or backwards
     /// (default [`DEFAULT_MAX_GAP_US`]); a larger one ends the stream.
     pub max_gap_us: Option<i64>,
+    /// In a container of several topics (a ROS bag), the topic to read (default: the first
+    /// topic of event messages).
+    pub topic: Option<String>,
 }
 
 /// A source of event batches.
@@ -140,6 +146,12 @@ pub enum Format {
     Aedat31,
     /// Plain text `t x y p`.
     Text,
+    /// Event Stream 2.x (`.es`).
+    EventStream,
+    /// The ATIS `.bin` of N-MNIST and N-Caltech101 (no header: told by its content).
+    AtisBin,
+    /// A ROS 1 bag (format 2.0) of event messages.
+    RosBag,
 }
 
 /// A byte stream a reader can read: a file, a `Cursor<Vec<u8>>`, stdin read into memory.
@@ -256,6 +268,12 @@ pub fn probe_source(src: &mut dyn Source, path: &Path) -> Result<Probed> {
     if head.starts_with(b"#!AER-DAT3") {
         return found(Format::Aedat31);
     }
+    if head.starts_with(eventstream::MAGIC) {
+        return found(Format::EventStream);
+    }
+    if head.starts_with(rosbag::MAGIC) {
+        return found(Format::RosBag);
+    }
     if head.starts_with(b"%") {
         let header = prophesee::read_header(src, path)?;
         src.seek(SeekFrom::Start(0))
@@ -302,6 +320,15 @@ pub fn probe_source(src: &mut dyn Source, path: &Path) -> Result<Probed> {
             break;
         }
     }
+    // headerless ATIS words: whole 5-byte words whose times never go back
+    let len = src
+        .seek(SeekFrom::End(0))
+        .map_err(|e| error::io_err(path, e))?;
+    src.seek(SeekFrom::Start(0))
+        .map_err(|e| error::io_err(path, e))?;
+    if atis::looks_like(&head, len) {
+        return found(Format::AtisBin);
+    }
     Err(unknown(format!(
         "unrecognised content starting with {:?}",
         String::from_utf8_lossy(&head[..n.min(16)])
@@ -336,6 +363,11 @@ pub fn open_source_with(
         path: path.to_path_buf(),
         reason,
     };
+    if opts.topic.is_some() && probed.format != Format::RosBag {
+        return Err(option_error(
+            "a topic can be named only for ROS bags".into(),
+        ));
+    }
     if opts.chip.is_some() && probed.format != Format::Aedat2 {
         return Err(option_error(
             "a chip can be named only for jAER AEDAT 2.0 files".into(),
@@ -353,6 +385,9 @@ pub fn open_source_with(
         Format::Aedat2 => jaer::aedat2_with(src, path, opts)?,
         Format::Aedat31 => jaer::aedat31_from(src, path)?,
         Format::Text => Box::new(TextReader::new(src, path)?),
+        Format::EventStream => eventstream::reader(src, path)?,
+        Format::AtisBin => atis::reader(src, path)?,
+        Format::RosBag => rosbag::reader(src, path, opts.topic.as_deref())?,
     };
     if let Some(c) = opts.camera {
         let n = reader.info().cameras.len().max(1);

@@ -180,6 +180,11 @@ pub(crate) trait WordDecoder: Send {
     fn decode(&mut self, chunk: &[u8], out: &mut EventBatch) -> std::result::Result<(), String>;
     /// Words that were not events, by kind.
     fn skipped(&self) -> Vec<(&'static str, u64)>;
+    /// At the end of the data: what an event begun and not finished lacks (a file cut short
+    /// inside an event of a byte-wise format), if any.
+    fn unfinished(&self) -> Option<String> {
+        None
+    }
 }
 
 /// A reader made of a [`WordReader`] and a format's [`WordDecoder`].
@@ -192,6 +197,8 @@ pub(crate) struct WordStream<D: WordDecoder> {
     offset: i64,
     /// The damage found in the chunk whose events before it were handed out last.
     failed: Option<EventError>,
+    /// The end of the data was reported.
+    ended: bool,
 }
 
 impl<D: WordDecoder> WordStream<D> {
@@ -209,6 +216,7 @@ impl<D: WordDecoder> WordStream<D> {
             info,
             offset: 0,
             failed: None,
+            ended: false,
         })
     }
 
@@ -234,6 +242,15 @@ impl<D: WordDecoder> EventReader for WordStream<D> {
         }
         loop {
             let Some(chunk) = self.words.next_chunk()? else {
+                if let Some(reason) = self.decoder.unfinished().filter(|_| !self.ended) {
+                    self.ended = true;
+                    return Err(EventError::Truncated {
+                        path: self.words.path.clone(),
+                        format: self.format,
+                        offset: self.words.chunk_offset(),
+                        reason,
+                    });
+                }
                 return Ok(None);
             };
             let mut batch = EventBatch::with_capacity(chunk.len() / D::WORD);

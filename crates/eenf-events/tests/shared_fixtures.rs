@@ -188,7 +188,7 @@ fn real_prophesee_files_match_the_reference_decoders() {
 fn every_fixture_survives_truncation_and_bit_flips() {
     let dir = tempfile::tempdir().unwrap();
     let mut files = Vec::new();
-    for sub in ["synthetic", "real"] {
+    for sub in ["synthetic", "real", "containers/other", "containers/ros1"] {
         for e in std::fs::read_dir(shared().join("fixtures").join(sub)).unwrap() {
             let p = e.unwrap().path();
             if p.extension().map(|e| e != "csv").unwrap_or(false) {
@@ -196,7 +196,7 @@ fn every_fixture_survives_truncation_and_bit_flips() {
             }
         }
     }
-    assert!(files.len() >= 18, "{files:?}");
+    assert!(files.len() >= 23, "{files:?}");
     for path in files {
         let bytes = std::fs::read(&path).unwrap();
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
@@ -233,5 +233,75 @@ fn every_fixture_survives_truncation_and_bit_flips() {
             std::fs::write(&damaged, &b).unwrap();
             let _ = read(&damaged);
         }
+    }
+}
+
+/// Counts, sums and ranges of a stream read to its end.
+fn summary(b: &EventBatch) -> (usize, usize, i64, i64, u64, u64) {
+    let on = b.p.iter().filter(|&&p| p).count();
+    let sx = b.x.iter().map(|&x| x as u64).sum();
+    let sy = b.y.iter().map(|&y| y as u64).sum();
+    (b.len(), on, b.t[0], b.t[b.len() - 1], sx, sy)
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn event_stream_and_atis_bin_decode_as_their_readme_says() {
+    let other = shared().join("fixtures/containers/other");
+    // Event Stream 2.0.0, DVS: 320×240, 473,225 events, t 0–999,000 µs
+    let path = other.join("faery_dvs.es");
+    let r = open(&path).unwrap();
+    assert_eq!(r.info().format, "Event Stream");
+    assert_eq!((r.info().width, r.info().height), (Some(320), Some(240)));
+    let b = read_all(&path);
+    let (n, _, t0, t1, ..) = summary(&b);
+    assert_eq!((n, t0, t1), (473_225, 0, 999_000));
+    assert!(b.t.windows(2).all(|w| w[0] <= w[1]));
+    assert!(b.x.iter().all(|&x| x < 320) && b.y.iter().all(|&y| y < 240));
+    // N-MNIST ATIS .bin: 34×34, 4,325 events, t 654–311,175 µs
+    let path = other.join("tonic_sample_nmnist.bin");
+    let b = read_all(&path);
+    let (n, _, t0, t1, ..) = summary(&b);
+    assert_eq!((n, t0, t1), (4_325, 654, 311_175));
+    assert!(b.x.iter().all(|&x| x < 34) && b.y.iter().all(|&y| y < 34));
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn ros1_bags_decode_as_their_readme_says() {
+    let ros1 = shared().join("fixtures/containers/ros1");
+    // the real Prophesee bag: evt3 packets, the clock's state carried across messages
+    let path = ros1.join("event_camera_py_test_events_1.bag");
+    let mut r = open(&path).unwrap();
+    assert_eq!(r.info().format, "ROS 1 bag");
+    let mut packets = EventBatch::default();
+    while let Some(b) = r.next_batch().unwrap() {
+        packets.extend_from(&b);
+    }
+    assert_eq!((r.info().width, r.info().height), (Some(640), Some(480)));
+    let (n, on, t0, t1, ..) = summary(&packets);
+    assert_eq!((n, on, t0, t1), (343_474, 125_183, 7_139_845, 9_218_023));
+    assert!(
+        r.skipped().contains(&("trigger", 4_157)),
+        "{:?}",
+        r.skipped()
+    );
+    // the dvs_msgs and prophesee_event_msgs bags hold its first 38,478 events in time order,
+    // stamped in ROS time: the same events, shifted by one constant
+    let mut first = packets.clone();
+    first.truncate(0);
+    let mut order: Vec<usize> = (0..packets.len()).collect();
+    order.sort_by_key(|&i| packets.t[i]);
+    for &i in order.iter().take(38_478) {
+        first.push(packets.t[i], packets.x[i], packets.y[i], packets.p[i]);
+    }
+    for name in ["ros1_dvs_msgs.bag", "ros1_prophesee_event_msgs.bag"] {
+        let b = read_all(&ros1.join(name));
+        assert_eq!(b.len(), 38_478, "{name}");
+        let shift = b.t[0] - first.t[0];
+        assert!(shift > 1_600_000_000_000_000, "{name}: ROS stamps, µs");
+        let mut shifted = b.clone();
+        shifted.t.iter_mut().for_each(|t| *t -= shift);
+        assert_eq!(canonical(&shifted), canonical(&first), "{name}");
     }
 }

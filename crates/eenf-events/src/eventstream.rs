@@ -1,0 +1,203 @@
+//! Event Stream 2.x (`.es`, neuromorphic-paris/event_stream), DVS type: a 15-byte signature and
+//! version, the type byte (`0x01`), width and height (u16 LE), then a byte-wise state machine.
+//!
+//! In the idle state a byte is an *overflow* (`0xFF`: 127 µs pass), a *reset* (`0xFE`: skipped,
+//! it resynchronises writers after bit errors) or an event's first byte: bits 7–1 the time since
+//! the previous event in µs, bit 0 `is_increase`. Four bytes follow: x and y, u16 little-endian.
+//! The other stream types (generic, ATIS, display, colour) are refused by name.
+
+use std::io::{Read, Seek, SeekFrom};
+use std::path::Path;
+
+use crate::error::{io_err, EventError, Result};
+use crate::stream::{WordDecoder, WordStream};
+use crate::{EventBatch, EventReader, Source, StreamInfo};
+
+/// The signature every Event Stream file starts with.
+pub const MAGIC: &[u8] = b"Event Stream";
+const FORMAT: &str = "Event Stream";
+/// Signature, version (3 bytes), type, width and height.
+const HEADER: usize = 20;
+
+/// The state machine of DVS events, carried across chunks.
+#[derive(Default)]
+struct DvsDecoder {
+    t: i64,
+    /// Bytes of the event being read (0: idle).
+    have: usize,
+    bytes: [u8; 5],
+    resets: u64,
+}
+
+impl WordDecoder for DvsDecoder {
+    const WORD: usize = 1;
+
+    fn decode(&mut self, chunk: &[u8], out: &mut EventBatch) -> std::result::Result<(), String> {
+        for &b in chunk {
+            if self.have == 0 {
+                match b {
+                    0xFF => self.t += 127,
+                    0xFE => self.resets += 1,
+                    _ => {
+                        self.bytes[0] = b;
+                        self.have = 1;
+                    }
+                }
+                continue;
+            }
+            self.bytes[self.have] = b;
+            self.have += 1;
+            if self.have == 5 {
+                self.have = 0;
+                let e = self.bytes;
+                self.t += (e[0] >> 1) as i64;
+                out.push(
+                    self.t,
+                    u16::from_le_bytes([e[1], e[2]]),
+                    u16::from_le_bytes([e[3], e[4]]),
+                    e[0] & 1 == 1,
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn unfinished(&self) -> Option<String> {
+        (self.have > 0).then(|| format!("the last event has {} of its 5 bytes", self.have))
+    }
+
+    fn skipped(&self) -> Vec<(&'static str, u64)> {
+        if self.resets > 0 {
+            vec![("reset bytes", self.resets)]
+        } else {
+            Vec::new()
+        }
+    }
+}
+
+/// A reader of an Event Stream file of DVS events.
+pub fn reader(mut src: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventReader>> {
+    src.seek(SeekFrom::Start(0)).map_err(|e| io_err(path, e))?;
+    let mut head = [0u8; HEADER];
+    let mut n = 0;
+    while n < HEADER {
+        match src.read(&mut head[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(io_err(path, e)),
+        }
+    }
+    let (major, minor, patch) = (head[12], head[13], head[14]);
+    if n < 16 || major != 2 {
+        return Err(EventError::Unfit {
+            path: path.to_path_buf(),
+            reason: if n < 16 {
+                "an Event Stream header cut short".into()
+            } else {
+                format!("Event Stream version {major}.{minor}.{patch}: eenf reads version 2")
+            },
+        });
+    }
+    let kind = match head[15] {
+        0 => "generic",
+        1 => "DVS",
+        2 => "ATIS",
+        3 => "asynchronous display",
+        4 => "colour",
+        _ => "unknown",
+    };
+    if head[15] != 1 {
+        return Err(EventError::Unfit {
+            path: path.to_path_buf(),
+            reason: format!(
+                "an Event Stream of {kind} events (type {}): eenf reads its DVS events (type 1) only",
+                head[15]
+            ),
+        });
+    }
+    if n < HEADER {
+        return Err(EventError::Truncated {
+            path: path.to_path_buf(),
+            format: FORMAT,
+            offset: n as u64,
+            reason: "the header ends before the sensor's size".into(),
+        });
+    }
+    let info = StreamInfo {
+        format: FORMAT,
+        codec: Some(format!("{major}.{minor}.{patch}, DVS")),
+        width: Some(u16::from_le_bytes([head[16], head[17]])),
+        height: Some(u16::from_le_bytes([head[18], head[19]])),
+        ..StreamInfo::default()
+    };
+    Ok(Box::new(WordStream::new(
+        src,
+        path,
+        HEADER as u64,
+        DvsDecoder::default(),
+        info,
+    )?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file(events: &[u8]) -> Vec<u8> {
+        let mut v = MAGIC.to_vec();
+        v.extend_from_slice(&[2, 0, 0, 1, 0x40, 0x01, 0xF0, 0x00]);
+        v.extend_from_slice(events);
+        v
+    }
+
+    fn read(bytes: Vec<u8>) -> Result<(StreamInfo, EventBatch)> {
+        let mut r = reader(Box::new(std::io::Cursor::new(bytes)), Path::new("t.es"))?;
+        let mut all = EventBatch::default();
+        while let Some(b) = r.next_batch()? {
+            all.extend_from(&b);
+        }
+        Ok((r.info().clone(), all))
+    }
+
+    #[test]
+    fn dvs_events_overflows_and_resets() {
+        // t 0: ON at (0, 239); five resets; two overflows then +3 µs: OFF at (319, 1)
+        let mut ev = vec![0x01, 0, 0, 0xEF, 0];
+        ev.extend_from_slice(&[0xFE; 5]);
+        ev.extend_from_slice(&[0xFF, 0xFF, 3 << 1, 0x3F, 0x01, 0x01, 0x00]);
+        // a reset value inside an event is data, not a reset
+        ev.extend_from_slice(&[1 << 1 | 1, 0xFE, 0x00, 0xFE, 0x00]);
+        let (info, b) = read(file(&ev)).unwrap();
+        assert_eq!((info.width, info.height), (Some(320), Some(240)));
+        assert_eq!(b.t, vec![0, 257, 258]);
+        assert_eq!(b.x, vec![0, 319, 254]);
+        assert_eq!(b.y, vec![239, 1, 254]);
+        assert_eq!(b.p, vec![true, false, true]);
+        // cut inside an event: the events before it, then the truncation
+        let mut cut = file(&ev);
+        cut.truncate(cut.len() - 2);
+        let mut r = reader(Box::new(std::io::Cursor::new(cut)), Path::new("t.es")).unwrap();
+        assert_eq!(r.next_batch().unwrap().unwrap().len(), 2);
+        let e = r.next_batch().unwrap_err().to_string();
+        assert!(
+            e.contains("truncated") && e.contains("3 of its 5 bytes"),
+            "{e}"
+        );
+        assert!(r.next_batch().unwrap().is_none());
+    }
+
+    #[test]
+    fn other_types_and_versions_are_refused_by_name() {
+        let mut atis = file(&[]);
+        atis[15] = 2;
+        let e = read(atis).unwrap_err().to_string();
+        assert!(e.contains("ATIS") && e.contains("t.es"), "{e}");
+        let mut v1 = file(&[]);
+        v1[12] = 1;
+        let e = read(v1).unwrap_err().to_string();
+        assert!(e.contains("version 1"), "{e}");
+        let e = read(MAGIC.to_vec()).unwrap_err().to_string();
+        assert!(e.contains("cut short"), "{e}");
+    }
+}

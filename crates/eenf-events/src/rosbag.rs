@@ -1,0 +1,693 @@
+//! ROS 1 bags (format 2.0, <http://wiki.ros.org/Bags/Format/2.0>) of event messages, read as a
+//! stream: `#ROSBAG V2.0\n`, then records, each a header (`u32` length, fields `u32 len` +
+//! `name=value`, `op` naming the record) and its data (`u32` length + bytes). The bag header
+//! (op 3) points at the index section, whose connection records (op 7) name every topic and its
+//! type; messages (op 2) sit in chunks (op 5), uncompressed, bz2 or lz4 (frame format).
+//!
+//! Messages read (ROS 1 serialisation: little-endian, no padding):
+//! - `dvs_msgs/EventArray` and `prophesee_event_msgs/EventArray`: a header, `u32` height and
+//!   width, then events of `u16 x, u16 y, time ts (u32 s, u32 ns), u8 polarity`; times are the
+//!   ROS stamps, in µs;
+//! - `event_camera_msgs/EventPacket` and `event_array_msgs/EventArray`: a header, `u32` height
+//!   and width, `u64` seq and time base, the encoding, `u8` is_bigendian, and the camera's own
+//!   bytes; `evt3` goes through the EVT 3.0 decoder, whose state (the 24-bit clock's loops)
+//!   carries from one message to the next.
+//!
+//! The first topic of an event type is read, or the one [`crate::OpenOptions::topic`] names.
+//! Sizes read from the file bound reads (never allocations): a chunk can hold no more than
+//! the file has left, and expands to at most [`MAX_CHUNK`].
+
+use std::collections::HashMap;
+use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+
+use crate::error::{io_err, EventError, Result};
+use crate::prophesee::Evt3;
+use crate::stream::WordDecoder;
+use crate::{EventBatch, EventReader, Source, StreamDesc, StreamInfo};
+
+/// The line every ROS 1 bag starts with.
+pub const MAGIC: &[u8] = b"#ROSBAG V2.0\n";
+const FORMAT: &str = "ROS 1 bag";
+/// The largest record header accepted.
+const MAX_HEADER: u32 = 1 << 20;
+/// The largest chunk accepted, expanded.
+pub const MAX_CHUNK: u64 = 1 << 30;
+
+const OP_MSG_DATA: u8 = 0x02;
+const OP_BAG_HEADER: u8 = 0x03;
+const OP_CHUNK: u8 = 0x05;
+const OP_CONNECTION: u8 = 0x07;
+
+/// The message types read, and how.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    /// An array of events with their own stamps (dvs_msgs, prophesee_event_msgs).
+    Events,
+    /// A packet of a camera's encoding (event_camera_msgs, event_array_msgs).
+    Packet,
+}
+
+fn kind_of(msg_type: &str) -> Option<Kind> {
+    match msg_type {
+        "dvs_msgs/EventArray" | "prophesee_event_msgs/EventArray" => Some(Kind::Events),
+        "event_camera_msgs/EventPacket" | "event_array_msgs/EventArray" => Some(Kind::Packet),
+        _ => None,
+    }
+}
+
+/// The header fields of a record.
+fn fields(h: &[u8]) -> HashMap<&[u8], &[u8]> {
+    let mut out = HashMap::new();
+    let mut i = 0;
+    while i + 4 <= h.len() {
+        let n = u32::from_le_bytes([h[i], h[i + 1], h[i + 2], h[i + 3]]) as usize;
+        i += 4;
+        let Some(f) = h.get(i..i.saturating_add(n)) else {
+            break;
+        };
+        i += n;
+        if let Some(eq) = f.iter().position(|&b| b == b'=') {
+            out.insert(&f[..eq], &f[eq + 1..]);
+        }
+    }
+    out
+}
+
+fn u32_of(f: &HashMap<&[u8], &[u8]>, name: &[u8]) -> Option<u32> {
+    let v = f.get(name)?;
+    Some(u32::from_le_bytes(v.get(..4)?.try_into().ok()?))
+}
+
+fn u64_of(f: &HashMap<&[u8], &[u8]>, name: &[u8]) -> Option<u64> {
+    let v = f.get(name)?;
+    Some(u64::from_le_bytes(v.get(..8)?.try_into().ok()?))
+}
+
+/// A little-endian cursor over one message's bytes.
+struct Msg<'a> {
+    b: &'a [u8],
+    i: usize,
+}
+
+impl<'a> Msg<'a> {
+    fn take(&mut self, n: usize) -> std::result::Result<&'a [u8], String> {
+        let s = self
+            .b
+            .get(self.i..self.i.saturating_add(n))
+            .ok_or_else(|| {
+                format!(
+                    "a message cut short ({} bytes, {} more wanted)",
+                    self.b.len(),
+                    n
+                )
+            })?;
+        self.i += n;
+        Ok(s)
+    }
+    fn u32(&mut self) -> std::result::Result<u32, String> {
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().unwrap_or_default(),
+        ))
+    }
+    fn u64(&mut self) -> std::result::Result<u64, String> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().unwrap_or_default(),
+        ))
+    }
+    fn string(&mut self) -> std::result::Result<&'a [u8], String> {
+        let n = self.u32()? as usize;
+        self.take(n)
+    }
+    /// `std_msgs/Header`: seq, stamp, frame_id.
+    fn header(&mut self) -> std::result::Result<(), String> {
+        self.take(12)?;
+        self.string()?;
+        Ok(())
+    }
+}
+
+/// A record read from the file: its header fields and its data.
+struct Record {
+    op: u8,
+    header: Vec<u8>,
+    data: Vec<u8>,
+}
+
+/// Reads one record from `r` (`left` bytes remain in the file); `None` at the end.
+fn read_record(r: &mut dyn Read, left: u64, path: &Path, at: u64) -> Result<Option<Record>> {
+    let corrupt = |reason: String| EventError::Corrupt {
+        path: path.to_path_buf(),
+        format: FORMAT,
+        offset: at,
+        reason,
+    };
+    let truncated = |reason: &str| EventError::Truncated {
+        path: path.to_path_buf(),
+        format: FORMAT,
+        offset: at,
+        reason: reason.into(),
+    };
+    if left == 0 {
+        return Ok(None);
+    }
+    let mut len = [0u8; 4];
+    read_exact(r, &mut len, path).map_err(|_| truncated("a record's header length"))?;
+    let hlen = u32::from_le_bytes(len);
+    if hlen > MAX_HEADER || hlen as u64 + 8 > left {
+        return Err(corrupt(format!("a record header of {hlen} bytes")));
+    }
+    let mut header = vec![0u8; hlen as usize];
+    read_exact(r, &mut header, path).map_err(|_| truncated("a record's header"))?;
+    read_exact(r, &mut len, path).map_err(|_| truncated("a record's data length"))?;
+    let dlen = u32::from_le_bytes(len) as u64;
+    if dlen + hlen as u64 + 8 > left {
+        return Err(truncated(&format!(
+            "a record announces {dlen} bytes of data, more than the file has left"
+        )));
+    }
+    let op = fields(&header)
+        .get(&b"op"[..])
+        .and_then(|v| v.first().copied())
+        .ok_or_else(|| corrupt("a record without an op field".into()))?;
+    // the length is bounded by the file: reading grows the buffer as bytes arrive
+    let mut data = Vec::new();
+    r.take(dlen)
+        .read_to_end(&mut data)
+        .map_err(|e| io_err(path, e))?;
+    if (data.len() as u64) < dlen {
+        return Err(truncated("a record's data"));
+    }
+    Ok(Some(Record { op, header, data }))
+}
+
+fn read_exact(r: &mut dyn Read, buf: &mut [u8], path: &Path) -> Result<()> {
+    r.read_exact(buf).map_err(|e| io_err(path, e))
+}
+
+/// A chunk's records, expanded.
+fn expand(rec: &Record, path: &Path, at: u64) -> Result<Vec<u8>> {
+    let f = fields(&rec.header);
+    let compression = f.get(&b"compression"[..]).copied().unwrap_or(b"none");
+    let size = u32_of(&f, b"size").unwrap_or(0) as u64;
+    let corrupt = |reason: String| EventError::Corrupt {
+        path: path.to_path_buf(),
+        format: FORMAT,
+        offset: at,
+        reason,
+    };
+    if size > MAX_CHUNK {
+        return Err(corrupt(format!("a chunk of {size} bytes")));
+    }
+    let mut out = Vec::new();
+    let bound = size.max(1) + 1;
+    let result = match compression {
+        b"none" => return Ok(rec.data.clone()),
+        b"bz2" => bzip2::read::BzDecoder::new(&rec.data[..])
+            .take(bound)
+            .read_to_end(&mut out),
+        b"lz4" => lz4_flex::frame::FrameDecoder::new(&rec.data[..])
+            .take(bound)
+            .read_to_end(&mut out),
+        other => {
+            return Err(corrupt(format!(
+                "a chunk compressed with {:?}, which eenf does not read",
+                String::from_utf8_lossy(other)
+            )))
+        }
+    };
+    result.map_err(|e| corrupt(format!("a chunk that does not expand: {e}")))?;
+    if out.len() as u64 != size {
+        return Err(corrupt(format!(
+            "a chunk that expands to {} bytes where its header says {size}",
+            out.len()
+        )));
+    }
+    Ok(out)
+}
+
+/// A topic of the bag.
+#[derive(Debug, Clone)]
+struct Topic {
+    name: String,
+    msg_type: String,
+}
+
+/// The reader of one topic of a ROS 1 bag.
+pub struct BagReader {
+    path: PathBuf,
+    src: BufReader<Box<dyn Source>>,
+    /// File offset of the next record, and the file's length.
+    pos: u64,
+    len: u64,
+    /// Where the index section starts (records from there on are not chunks).
+    index_pos: u64,
+    /// The chunk being read: its expanded records and the offset of the next one.
+    chunk: Vec<u8>,
+    in_chunk: usize,
+    chunk_at: u64,
+    /// Connection ids of the topic read, and how its messages are decoded.
+    conns: Vec<u32>,
+    kind: Kind,
+    evt3: Evt3,
+    info: StreamInfo,
+    failed: Option<EventError>,
+    done: bool,
+    other_encodings: u64,
+}
+
+/// A reader of the event topic of the bag in `src` (named `path`): `topic`, or the first topic
+/// of an event type.
+pub fn reader(
+    mut src: Box<dyn Source>,
+    path: &Path,
+    topic: Option<&str>,
+) -> Result<Box<dyn EventReader>> {
+    let io = |e| io_err(path, e);
+    let len = src.seek(SeekFrom::End(0)).map_err(io)?;
+    src.seek(SeekFrom::Start(MAGIC.len() as u64)).map_err(io)?;
+    let mut r = BufReader::with_capacity(1 << 16, src);
+    let start = MAGIC.len() as u64;
+    let head = read_record(&mut r, len.saturating_sub(start), path, start)?.ok_or_else(|| {
+        EventError::Truncated {
+            path: path.to_path_buf(),
+            format: FORMAT,
+            offset: start,
+            reason: "no bag header record".into(),
+        }
+    })?;
+    if head.op != OP_BAG_HEADER {
+        return Err(EventError::Corrupt {
+            path: path.to_path_buf(),
+            format: FORMAT,
+            offset: start,
+            reason: format!("the first record is op {}, not the bag header", head.op),
+        });
+    }
+    let hf = fields(&head.header);
+    let first_record = start + 8 + head.header.len() as u64 + head.data.len() as u64;
+    let index_pos = u64_of(&hf, b"index_pos").unwrap_or(0);
+    // the connections, from the index section when the bag was closed properly
+    let mut topics: Vec<(u32, Topic)> = Vec::new();
+    if index_pos > first_record && index_pos < len {
+        r.seek(SeekFrom::Start(index_pos)).map_err(io)?;
+        let mut at = index_pos;
+        while let Ok(Some(rec)) = read_record(&mut r, len.saturating_sub(at), path, at) {
+            at += 8 + rec.header.len() as u64 + rec.data.len() as u64;
+            if rec.op == OP_CONNECTION {
+                if let Some(t) = connection(&rec) {
+                    topics.push(t);
+                }
+            }
+        }
+    }
+    r.seek(SeekFrom::Start(first_record)).map_err(io)?;
+    let wanted = |t: &Topic| match topic {
+        Some(name) => t.name == name,
+        None => kind_of(&t.msg_type).is_some(),
+    };
+    let chosen: Vec<&(u32, Topic)> = topics.iter().filter(|(_, t)| wanted(t)).collect();
+    let listing = || {
+        let mut names: Vec<String> = topics
+            .iter()
+            .map(|(_, t)| format!("{} ({})", t.name, t.msg_type))
+            .collect();
+        names.dedup();
+        names.join(", ")
+    };
+    let Some((_, first)) = chosen.first() else {
+        return Err(EventError::Unfit {
+            path: path.to_path_buf(),
+            reason: match topic {
+                Some(name) => format!("no topic {name:?} in the bag; it has: {}", listing()),
+                None if topics.is_empty() => "a bag without an index (not closed properly): give --topic, or reindex it with `rosbag reindex`".into(),
+                None => format!("no topic of event messages (dvs_msgs/EventArray, prophesee_event_msgs/EventArray, event_camera_msgs/EventPacket) in the bag; it has: {}", listing()),
+            },
+        });
+    };
+    let Some(kind) = kind_of(&first.msg_type) else {
+        return Err(EventError::Unfit {
+            path: path.to_path_buf(),
+            reason: format!(
+                "topic {} carries {}, not event messages eenf reads",
+                first.name, first.msg_type
+            ),
+        });
+    };
+    let name = first.name.clone();
+    let conns: Vec<u32> = topics
+        .iter()
+        .filter(|(_, t)| t.name == name)
+        .map(|(c, _)| *c)
+        .collect();
+    let info = StreamInfo {
+        format: FORMAT,
+        codec: Some(format!("{} on {}", first.msg_type, name)),
+        streams: topics
+            .iter()
+            .map(|(c, t)| StreamDesc {
+                id: *c as i32,
+                kind: t.msg_type.clone(),
+                source: Some(t.name.clone()),
+                ..StreamDesc::default()
+            })
+            .collect(),
+        ..StreamInfo::default()
+    };
+    Ok(Box::new(BagReader {
+        path: path.to_path_buf(),
+        src: r,
+        pos: first_record,
+        len,
+        index_pos: if index_pos > first_record {
+            index_pos
+        } else {
+            len
+        },
+        chunk: Vec::new(),
+        in_chunk: 0,
+        chunk_at: first_record,
+        conns,
+        kind,
+        evt3: Evt3::default(),
+        info,
+        failed: None,
+        done: false,
+        other_encodings: 0,
+    }))
+}
+
+/// A connection record's id, topic and type.
+fn connection(rec: &Record) -> Option<(u32, Topic)> {
+    let f = fields(&rec.header);
+    let conn = u32_of(&f, b"conn")?;
+    let d = fields(&rec.data);
+    let name = String::from_utf8_lossy(f.get(&b"topic"[..])?).into_owned();
+    let msg_type =
+        String::from_utf8_lossy(d.get(&b"type"[..]).copied().unwrap_or(b"")).into_owned();
+    Some((conn, Topic { name, msg_type }))
+}
+
+impl BagReader {
+    /// Decodes one message of the topic into `out`.
+    fn message(&mut self, data: &[u8], out: &mut EventBatch) -> std::result::Result<(), String> {
+        let mut m = Msg { b: data, i: 0 };
+        m.header()?;
+        let height = m.u32()?;
+        let width = m.u32()?;
+        if self.info.width.is_none() && width > 0 && width <= u16::MAX as u32 {
+            self.info.width = Some(width as u16);
+            self.info.height = Some(height.min(u16::MAX as u32) as u16);
+        }
+        match self.kind {
+            Kind::Events => {
+                let n = m.u32()? as usize;
+                let bytes = m.take(n.checked_mul(13).ok_or("an event count beyond reason")?)?;
+                for e in bytes.chunks_exact(13) {
+                    let s = u32::from_le_bytes([e[4], e[5], e[6], e[7]]) as i64;
+                    let ns = u32::from_le_bytes([e[8], e[9], e[10], e[11]]) as i64;
+                    out.push(
+                        s * 1_000_000 + ns / 1000,
+                        u16::from_le_bytes([e[0], e[1]]),
+                        u16::from_le_bytes([e[2], e[3]]),
+                        e[12] != 0,
+                    );
+                }
+            }
+            Kind::Packet => {
+                m.u64()?; // seq
+                m.u64()?; // time base
+                let encoding = m.string()?;
+                m.take(1)?; // is_bigendian
+                let bytes = m.string()?;
+                match encoding {
+                    b"evt3" => self.evt3.decode(&bytes[..bytes.len() / 2 * 2], out)?,
+                    _ => {
+                        self.other_encodings += 1;
+                        if self.other_encodings == 1 {
+                            return Err(format!(
+                                "packets in the {:?} encoding, which eenf does not read yet (it reads evt3)",
+                                String::from_utf8_lossy(encoding)
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn fail(&mut self, e: EventError, batch: EventBatch) -> Result<Option<EventBatch>> {
+        self.done = true;
+        if batch.is_empty() {
+            return Err(e);
+        }
+        self.failed = Some(e);
+        Ok(Some(batch))
+    }
+}
+
+impl EventReader for BagReader {
+    fn info(&self) -> &StreamInfo {
+        &self.info
+    }
+
+    fn next_batch(&mut self) -> Result<Option<EventBatch>> {
+        if let Some(e) = self.failed.take() {
+            return Err(e);
+        }
+        let mut batch = EventBatch::default();
+        while batch.len() < 1 << 16 && !self.done {
+            // the next record of the chunk being read
+            if self.in_chunk < self.chunk.len() {
+                let at = self.chunk_at;
+                let left = (self.chunk.len() - self.in_chunk) as u64;
+                let mut r = &self.chunk[self.in_chunk..];
+                let rec = match read_record(&mut r, left, &self.path, at) {
+                    Ok(Some(rec)) => rec,
+                    Ok(None) => break,
+                    Err(e) => return self.fail(e, batch),
+                };
+                self.in_chunk += 8 + rec.header.len() + rec.data.len();
+                if rec.op == OP_MSG_DATA {
+                    let conn = u32_of(&fields(&rec.header), b"conn");
+                    if conn.is_some_and(|c| self.conns.contains(&c)) {
+                        if let Err(reason) = self.message(&rec.data, &mut batch) {
+                            let e = EventError::Corrupt {
+                                path: self.path.clone(),
+                                format: FORMAT,
+                                offset: at,
+                                reason,
+                            };
+                            return self.fail(e, batch);
+                        }
+                    }
+                }
+                continue;
+            }
+            if self.pos >= self.index_pos {
+                self.done = true;
+                break;
+            }
+            let at = self.pos;
+            let rec = match read_record(&mut self.src, self.len.saturating_sub(at), &self.path, at)
+            {
+                Ok(Some(rec)) => rec,
+                Ok(None) => {
+                    self.done = true;
+                    break;
+                }
+                Err(e) => return self.fail(e, batch),
+            };
+            self.pos += 8 + rec.header.len() as u64 + rec.data.len() as u64;
+            if rec.op == OP_CHUNK {
+                match expand(&rec, &self.path, at) {
+                    Ok(c) => {
+                        self.chunk = c;
+                        self.in_chunk = 0;
+                        self.chunk_at = at;
+                    }
+                    Err(e) => return self.fail(e, batch),
+                }
+            }
+        }
+        Ok((!batch.is_empty()).then_some(batch))
+    }
+
+    fn batch_offset(&self) -> Option<u64> {
+        Some(self.chunk_at)
+    }
+
+    fn skipped(&self) -> Vec<(&'static str, u64)> {
+        self.evt3.skipped()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn field(name: &str, value: &[u8]) -> Vec<u8> {
+        let mut f = ((name.len() + 1 + value.len()) as u32)
+            .to_le_bytes()
+            .to_vec();
+        f.extend_from_slice(name.as_bytes());
+        f.push(b'=');
+        f.extend_from_slice(value);
+        f
+    }
+
+    fn record(header: &[Vec<u8>], data: &[u8]) -> Vec<u8> {
+        let h: Vec<u8> = header.concat();
+        let mut r = (h.len() as u32).to_le_bytes().to_vec();
+        r.extend_from_slice(&h);
+        r.extend_from_slice(&(data.len() as u32).to_le_bytes());
+        r.extend_from_slice(data);
+        r
+    }
+
+    fn connection(conn: u32, topic: &str, msg_type: &str) -> Vec<u8> {
+        record(
+            &[
+                field("op", &[OP_CONNECTION]),
+                field("conn", &conn.to_le_bytes()),
+                field("topic", topic.as_bytes()),
+            ],
+            &[
+                field("topic", topic.as_bytes()),
+                field("type", msg_type.as_bytes()),
+            ]
+            .concat(),
+        )
+    }
+
+    /// A `dvs_msgs/EventArray` of events `(s, ns, x, y, p)`.
+    fn event_array(events: &[(u32, u32, u16, u16, bool)]) -> Vec<u8> {
+        let mut m = vec![0u8; 12];
+        m.extend_from_slice(&0u32.to_le_bytes()); // frame_id ""
+        m.extend_from_slice(&480u32.to_le_bytes());
+        m.extend_from_slice(&640u32.to_le_bytes());
+        m.extend_from_slice(&(events.len() as u32).to_le_bytes());
+        for &(s, ns, x, y, p) in events {
+            m.extend_from_slice(&x.to_le_bytes());
+            m.extend_from_slice(&y.to_le_bytes());
+            m.extend_from_slice(&s.to_le_bytes());
+            m.extend_from_slice(&ns.to_le_bytes());
+            m.push(p as u8);
+        }
+        m
+    }
+
+    fn message(conn: u32, data: &[u8]) -> Vec<u8> {
+        record(
+            &[
+                field("op", &[OP_MSG_DATA]),
+                field("conn", &conn.to_le_bytes()),
+                field("time", &0u64.to_le_bytes()),
+            ],
+            data,
+        )
+    }
+
+    /// A bag of two topics (an IMU first), its messages in one chunk compressed as asked.
+    fn bag(compression: &str) -> Vec<u8> {
+        let mut inner = connection(0, "/imu", "sensor_msgs/Imu");
+        inner.extend(connection(1, "/dvs/events", "dvs_msgs/EventArray"));
+        inner.extend(message(0, &[1, 2, 3]));
+        inner.extend(message(
+            1,
+            &event_array(&[(10, 1000, 1, 2, true), (10, 3000, 3, 4, false)]),
+        ));
+        inner.extend(message(1, &event_array(&[(11, 0, 5, 6, true)])));
+        let packed = match compression {
+            "none" => inner.clone(),
+            "lz4" => {
+                let mut w = lz4_flex::frame::FrameEncoder::new(Vec::new());
+                std::io::Write::write_all(&mut w, &inner).unwrap();
+                w.finish().unwrap()
+            }
+            _ => {
+                let mut w = bzip2::write::BzEncoder::new(Vec::new(), bzip2::Compression::fast());
+                std::io::Write::write_all(&mut w, &inner).unwrap();
+                w.finish().unwrap()
+            }
+        };
+        let chunk = record(
+            &[
+                field("op", &[OP_CHUNK]),
+                field("compression", compression.as_bytes()),
+                field("size", &(inner.len() as u32).to_le_bytes()),
+            ],
+            &packed,
+        );
+        let index = [
+            connection(0, "/imu", "sensor_msgs/Imu"),
+            connection(1, "/dvs/events", "dvs_msgs/EventArray"),
+        ]
+        .concat();
+        let head_len =
+            MAGIC.len() + record(&[field("op", &[3]), field("index_pos", &[0; 8])], &[0; 16]).len();
+        let index_pos = (head_len + chunk.len()) as u64;
+        let mut b = MAGIC.to_vec();
+        b.extend(record(
+            &[
+                field("op", &[OP_BAG_HEADER]),
+                field("index_pos", &index_pos.to_le_bytes()),
+            ],
+            &[0; 16],
+        ));
+        b.extend(chunk);
+        b.extend(index);
+        b
+    }
+
+    fn read(bytes: Vec<u8>, topic: Option<&str>) -> Result<(StreamInfo, EventBatch)> {
+        let mut r = reader(
+            Box::new(std::io::Cursor::new(bytes)),
+            Path::new("t.bag"),
+            topic,
+        )?;
+        let mut all = EventBatch::default();
+        while let Some(b) = r.next_batch()? {
+            all.extend_from(&b);
+        }
+        Ok((r.info().clone(), all))
+    }
+
+    #[test]
+    fn event_arrays_in_every_chunk_compression() {
+        for c in ["none", "bz2", "lz4"] {
+            let (info, b) = read(bag(c), None).unwrap();
+            assert_eq!(b.t, vec![10_000_001, 10_000_003, 11_000_000], "{c}");
+            assert_eq!(
+                (b.x, b.y, b.p),
+                (vec![1, 3, 5], vec![2, 4, 6], vec![true, false, true])
+            );
+            assert_eq!((info.width, info.height), (Some(640), Some(480)));
+            assert_eq!(info.streams.len(), 2);
+        }
+    }
+
+    #[test]
+    fn topics_that_are_not_there_or_not_events_are_named() {
+        let e = read(bag("none"), Some("/nope")).unwrap_err().to_string();
+        assert!(
+            e.contains("/nope") && e.contains("/dvs/events (dvs_msgs/EventArray)"),
+            "{e}"
+        );
+        let e = read(bag("none"), Some("/imu")).unwrap_err().to_string();
+        assert!(e.contains("sensor_msgs/Imu"), "{e}");
+        // cut anywhere: an error or the events before the cut, never a panic
+        let whole = bag("lz4");
+        for cut in 0..whole.len() {
+            let r = reader(
+                Box::new(std::io::Cursor::new(whole[..cut].to_vec())),
+                Path::new("t.bag"),
+                None,
+            );
+            if let Ok(mut r) = r {
+                while let Ok(Some(_)) = r.next_batch() {}
+            }
+        }
+    }
+}
