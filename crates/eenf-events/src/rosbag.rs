@@ -251,6 +251,8 @@ pub struct BagReader {
     kind: Kind,
     evt3: Evt3,
     info: StreamInfo,
+    /// The first batch, read on opening (the sensor's size is in the messages).
+    pending: Option<EventBatch>,
     failed: Option<EventError>,
     done: bool,
     other_encodings: u64,
@@ -354,7 +356,7 @@ pub fn reader(
             .collect(),
         ..StreamInfo::default()
     };
-    Ok(Box::new(BagReader {
+    let mut bag = BagReader {
         path: path.to_path_buf(),
         src: r,
         pos: first_record,
@@ -371,10 +373,17 @@ pub fn reader(
         kind,
         evt3: Evt3::default(),
         info,
+        pending: None,
         failed: None,
         done: false,
         other_encodings: 0,
-    }))
+    };
+    // the sensor's size comes with the first message: read it now, hand it out first
+    match bag.read_batch() {
+        Ok(b) => bag.pending = b,
+        Err(e) => bag.failed = Some(e),
+    }
+    Ok(Box::new(bag))
 }
 
 /// A connection record's id, topic and type.
@@ -453,9 +462,27 @@ impl EventReader for BagReader {
     }
 
     fn next_batch(&mut self) -> Result<Option<EventBatch>> {
+        if let Some(b) = self.pending.take() {
+            return Ok(Some(b));
+        }
         if let Some(e) = self.failed.take() {
             return Err(e);
         }
+        self.read_batch()
+    }
+
+    fn batch_offset(&self) -> Option<u64> {
+        Some(self.chunk_at)
+    }
+
+    fn skipped(&self) -> Vec<(&'static str, u64)> {
+        self.evt3.skipped()
+    }
+}
+
+impl BagReader {
+    /// The next batch of the topic's events, `None` at the end.
+    fn read_batch(&mut self) -> Result<Option<EventBatch>> {
         let mut batch = EventBatch::default();
         while batch.len() < 1 << 16 && !self.done {
             // the next record of the chunk being read
@@ -512,14 +539,6 @@ impl EventReader for BagReader {
             }
         }
         Ok((!batch.is_empty()).then_some(batch))
-    }
-
-    fn batch_offset(&self) -> Option<u64> {
-        Some(self.chunk_at)
-    }
-
-    fn skipped(&self) -> Vec<(&'static str, u64)> {
-        self.evt3.skipped()
     }
 }
 
@@ -656,6 +675,13 @@ mod tests {
 
     #[test]
     fn event_arrays_in_every_chunk_compression() {
+        // the sensor's size is known on opening (flicker maps lay their tiles with it)
+        let r = reader(
+            Box::new(std::io::Cursor::new(bag("none"))),
+            Path::new("t.bag"),
+            None,
+        );
+        assert_eq!(r.unwrap().info().width, Some(640));
         for c in ["none", "bz2", "lz4"] {
             let (info, b) = read(bag(c), None).unwrap();
             assert_eq!(b.t, vec![10_000_001, 10_000_003, 11_000_000], "{c}");

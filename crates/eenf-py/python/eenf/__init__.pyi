@@ -79,6 +79,7 @@ def read_events(
     camera: Optional[int] = None,
     strict: bool = False,
     max_gap: float = 5.0,
+    topic: Optional[str] = None,
 ) -> np.ndarray: ...
 def iter_events(
     path: PathLike,
@@ -88,6 +89,7 @@ def iter_events(
     camera: Optional[int] = None,
     strict: bool = False,
     max_gap: float = 5.0,
+    topic: Optional[str] = None,
 ) -> Iterator[np.ndarray]: ...
 def info(
     path: PathLike,
@@ -96,6 +98,7 @@ def info(
     camera: Optional[int] = None,
     strict: bool = False,
     max_gap: float = 5.0,
+    topic: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def write_events(
     path: PathLike,
@@ -132,6 +135,7 @@ def extract(
     camera: Optional[int] = None,
     strict: bool = False,
     max_gap: float = 5.0,
+    topic: Optional[str] = None,
 ) -> Trace: ...
 def reference(
     source: Union[PathLike, npt.ArrayLike],
@@ -164,6 +168,7 @@ def edits(
     camera: Optional[int] = None,
     strict: bool = False,
     max_gap: float = 5.0,
+    topic: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def video(
     path: PathLike,
