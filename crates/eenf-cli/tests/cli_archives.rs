@@ -4,19 +4,14 @@
 
 use std::io::Write;
 use std::path::Path;
-use std::process::{Command, Output};
+
+mod cli;
+use cli::eenf;
 
 use eenf::refdb::RefSeries;
 use eenf::time::{parse_time, Zone};
 
-fn eenf(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eenf"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("eenf runs")
-}
-
+/// Runs `eenf ARGS`, which must succeed: its stdout and stderr.
 fn ok(args: &[&str], dir: &Path) -> (String, String) {
     let out = eenf(args, dir);
     let err = String::from_utf8_lossy(&out.stderr).into_owned();

@@ -4,7 +4,9 @@
 //! `.ci/run` runs it.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+
+mod cli;
+use cli::{eenf, ok};
 
 #[path = "../../eenf/tests/common/mod.rs"]
 mod common;
@@ -13,24 +15,6 @@ fn archives() -> PathBuf {
     common::shared("fixtures/grid-archives")
         .join("fixtures")
         .join("grid-archives")
-}
-
-fn eenf(args: &[&str], dir: &Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_eenf"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("eenf runs")
-}
-
-fn ok(args: &[&str], dir: &Path) -> String {
-    let out = eenf(args, dir);
-    assert!(
-        out.status.success(),
-        "eenf {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
 /// The `time,value` rows of a CSV fixture (header skipped).
