@@ -440,7 +440,8 @@ pub fn build_store(
         check_grid_name(g)?;
     }
     // each input as the files it stands for: a folder of hourly WAVs gives its hours in order
-    let mut files: Vec<(PathBuf, Option<f64>)> = Vec::new();
+    // (file, its start when given as FILE@TIME, whether it is a grid archive)
+    let mut files: Vec<(PathBuf, Option<f64>, bool)> = Vec::new();
     for input in &build.inputs {
         let (path, at) = match input.rsplit_once('@') {
             Some((p, t)) if !Path::new(input).exists() => {
@@ -449,14 +450,17 @@ pub fn build_store(
             _ => (PathBuf::from(input), None),
         };
         match ReferenceSource::open(&path)? {
-            ReferenceSource::HourlyFolder(dir) => {
-                files.extend(hourly_references(&dir)?.into_iter().map(|(_, f)| (f, None)))
-            }
+            ReferenceSource::HourlyFolder(dir) => files.extend(
+                hourly_references(&dir)?
+                    .into_iter()
+                    .map(|(_, f)| (f, None, false)),
+            ),
             ReferenceSource::Store(dir) => bail!(
                 "{}: a reference store; its series cannot be added to another store",
                 dir.display()
             ),
-            _ => files.push((path, at)),
+            ReferenceSource::Archive(p) => files.push((p, at, at.is_none())),
+            _ => files.push((path, at, false)),
         }
     }
     // the whole read-merge-write under the store's lock: a second build waits for this one
@@ -465,7 +469,7 @@ pub fn build_store(
     let mut series: Vec<RefSeries> = Vec::new();
     let mut next_start = build.start;
     let mut archives = Vec::new();
-    for (path, at) in &files {
+    for (path, at, archive) in &files {
         let (start, step, values, f0) = if is_wav(path) {
             let trace = reference_file(path, Nominal::Auto, &EnfParams::default())?;
             let start = match at {
@@ -474,7 +478,7 @@ pub fn build_store(
             };
             let f0 = nominal_of(&trace, path)?;
             (start, trace.step_s, trace.enf_hz, f0)
-        } else if at.is_none() && crate::archive::is_archive(path) {
+        } else if *archive {
             let opts = ArchiveOptions {
                 zone: build.zone.clone(),
                 ..build.archive.clone()
