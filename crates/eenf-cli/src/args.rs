@@ -161,8 +161,8 @@ pub struct InputArgs {
     /// backwards: a larger one (a corrupt timestamp) ends the usable stream there.
     #[arg(long, default_value_t = eenf_events::DEFAULT_MAX_GAP_US as f64 * 1e-6)]
     pub max_gap: f64,
-    /// The topic to read in a ROS bag (default: the first topic of event messages; `info`
-    /// lists them all).
+    /// The topic to read in a ROS 1 bag or a rosbag2 (default: the first topic of event
+    /// messages; `info` lists them all).
     #[arg(long)]
     pub topic: Option<String>,
 }

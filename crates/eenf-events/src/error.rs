@@ -56,6 +56,16 @@ pub enum EventError {
         /// What was being read.
         reason: String,
     },
+    /// A container (an SQLite database) reports damage where no byte offset is known.
+    #[error("{path}: damaged {format}: {reason}")]
+    Damaged {
+        /// The file.
+        path: PathBuf,
+        /// The format being read.
+        format: &'static str,
+        /// What the container's own reader said.
+        reason: String,
+    },
 }
 
 /// Shorthand for results of this crate.

@@ -17,7 +17,8 @@
 //! # Ok::<(), eenf_events::EventError>(())
 //! ```
 
-// `unsafe` only in the one call into liblz4 (`aedat4::lz4`), which allows it there
+// `unsafe` only in the calls into liblz4 (`aedat4::lz4`) and c-blosc (`hdf5::filters`), which
+// allow it there
 #![deny(unsafe_code)]
 
 pub mod aedat4;
@@ -26,11 +27,14 @@ pub mod contain;
 mod error;
 pub mod eventstream;
 mod guard;
+pub mod hdf5;
 pub mod jaer;
 pub mod memory;
 mod prefetch;
 pub mod prophesee;
 pub mod rosbag;
+pub mod rosbag2;
+mod rosmsg;
 mod stream;
 pub mod text;
 pub mod writers;
@@ -47,7 +51,7 @@ pub use memory::open_events;
 pub use text::TextReader;
 
 /// The formats this version reads, for error messages.
-pub const SUPPORTED: &str = "AEDAT 4.0 (.aedat4), Prophesee EVT 2.0/2.1/3.0 (.raw) and DAT (.dat), jAER AEDAT 2.0/3.1 (.aedat), ROS 1 bags of event messages (.bag), Event Stream 2 DVS (.es), ATIS .bin (N-MNIST, N-Caltech101), text (t x y p)";
+pub const SUPPORTED: &str = "AEDAT 4.0 (.aedat4), Prophesee EVT 2.0/2.1/3.0 (.raw) and DAT (.dat), jAER AEDAT 2.0/3.1 (.aedat), ROS 1 bags (.bag) and rosbag2 folders (.db3, .mcap) of event messages, Event Stream 2 DVS (.es), HDF5 (DSEC, M3ED, MVSEC, TUM-VIE, Prophesee CD/events), ATIS .bin (N-MNIST, N-Caltech101), text (t x y p)";
 
 /// One data stream declared by a file (AEDAT4 files can carry events, frames, IMU, triggers).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -60,8 +64,10 @@ pub struct StreamDesc {
     pub width: Option<u16>,
     /// Sensor height, when declared.
     pub height: Option<u16>,
-    /// Camera name, when declared.
+    /// Camera name, when declared; the topic, in a bag.
     pub source: Option<String>,
+    /// Messages of the stream, when the container counts them (a bag's topics).
+    pub messages: Option<u64>,
 }
 
 /// What a reader knows about a recording before reading its events.
@@ -89,6 +95,10 @@ pub struct StreamInfo {
     pub cameras: Vec<String>,
     /// The camera read, when there are several and one was picked.
     pub camera: Option<u8>,
+    /// Where in a container the events come from: `topic /dvs/events (dvs_msgs/EventArray)`
+    /// in a bag (with the camera encoding of its packets), `group /events` or `dataset
+    /// /CD/events` in an HDF5 file.
+    pub within: Option<String>,
     /// What the reader had to infer or assume (e.g. a chip not named in the header).
     pub notes: Vec<String>,
 }
@@ -152,6 +162,10 @@ pub enum Format {
     AtisBin,
     /// A ROS 1 bag (format 2.0) of event messages.
     RosBag,
+    /// A rosbag2 of event messages: its folder, or one storage file (SQLite or MCAP).
+    Rosbag2,
+    /// HDF5 (DSEC, M3ED, MVSEC, TUM-VIE, Prophesee's own).
+    Hdf5,
 }
 
 /// A byte stream a reader can read: a file, a `Cursor<Vec<u8>>`, stdin read into memory.
@@ -173,8 +187,12 @@ pub struct Probed {
     header: Option<stream::TextHeader>,
 }
 
-/// Decides the format of the file at `path` from its first bytes (`-`: stdin).
+/// Decides the format of the file at `path` from its first bytes (`-`: stdin); a folder is a
+/// rosbag2 when it holds its storage files.
 pub fn probe(path: &Path) -> Result<Format> {
+    if path.is_dir() {
+        return folder_format(path);
+    }
     let mut f = open_file(path)?;
     Ok(probe_source(f.as_mut(), path)?.format)
 }
@@ -229,6 +247,18 @@ fn reopen(f: &std::fs::File) -> std::io::Result<Box<dyn Source>> {
     Ok(Box::new(g))
 }
 
+/// The format of the folder `dir`: a rosbag2, or an error naming the folder.
+fn folder_format(dir: &Path) -> Result<Format> {
+    if rosbag2::is_folder(dir) {
+        return Ok(Format::Rosbag2);
+    }
+    Err(EventError::UnknownFormat {
+        path: dir.to_path_buf(),
+        reason: "a folder that is not a rosbag2 (no metadata.yaml, .db3 or .mcap in it)".into(),
+        supported: SUPPORTED,
+    })
+}
+
 /// Decides the format of `src` (named `path` in errors) from its first bytes; leaves `src`
 /// at its start.
 pub fn probe_source(src: &mut dyn Source, path: &Path) -> Result<Probed> {
@@ -273,6 +303,12 @@ pub fn probe_source(src: &mut dyn Source, path: &Path) -> Result<Probed> {
     }
     if head.starts_with(rosbag::MAGIC) {
         return found(Format::RosBag);
+    }
+    if head.starts_with(rosbag2::SQLITE_MAGIC) || head.starts_with(rosbag2::MCAP_MAGIC) {
+        return found(Format::Rosbag2);
+    }
+    if head.starts_with(hdf5::MAGIC) {
+        return found(Format::Hdf5);
     }
     if head.starts_with(b"%") {
         let header = prophesee::read_header(src, path)?;
@@ -340,8 +376,14 @@ pub fn open(path: &Path) -> Result<Box<dyn EventReader>> {
     open_with(path, &OpenOptions::default())
 }
 
-/// Opens an event file as `opts` say.
+/// Opens an event file (or a rosbag2 folder) as `opts` say.
 pub fn open_with(path: &Path, opts: &OpenOptions) -> Result<Box<dyn EventReader>> {
+    if path.is_dir() {
+        folder_format(path)?;
+        check_options(Format::Rosbag2, path, opts)?;
+        let reader = rosbag2::folder(path, opts.topic.as_deref())?;
+        return finish(reader, Format::Rosbag2, path, opts);
+    }
     let f = open_file(path)?;
     open_source_with(f, path, opts)
 }
@@ -359,20 +401,7 @@ pub fn open_source_with(
     opts: &OpenOptions,
 ) -> Result<Box<dyn EventReader>> {
     let probed = probe_source(src.as_mut(), path)?;
-    let option_error = |reason: String| EventError::Unfit {
-        path: path.to_path_buf(),
-        reason,
-    };
-    if opts.topic.is_some() && probed.format != Format::RosBag {
-        return Err(option_error(
-            "a topic can be named only for ROS bags".into(),
-        ));
-    }
-    if opts.chip.is_some() && probed.format != Format::Aedat2 {
-        return Err(option_error(
-            "a chip can be named only for jAER AEDAT 2.0 files".into(),
-        ));
-    }
+    check_options(probed.format, path, opts)?;
     let reader: Box<dyn EventReader> = match probed.format {
         Format::Aedat4 => Box::new(Aedat4Reader::new(src, path)?),
         Format::Prophesee(kind) => {
@@ -388,6 +417,40 @@ pub fn open_source_with(
         Format::EventStream => eventstream::reader(src, path)?,
         Format::AtisBin => atis::reader(src, path)?,
         Format::RosBag => rosbag::reader(src, path, opts.topic.as_deref())?,
+        Format::Rosbag2 => rosbag2::reader(src, path, opts.topic.as_deref())?,
+        Format::Hdf5 => hdf5::reader(src, path, opts.camera)?,
+    };
+    finish(reader, probed.format, path, opts)
+}
+
+/// Refuses options that the format cannot take.
+fn check_options(format: Format, path: &Path, opts: &OpenOptions) -> Result<()> {
+    let option_error = |reason: &str| {
+        Err(EventError::Unfit {
+            path: path.to_path_buf(),
+            reason: reason.into(),
+        })
+    };
+    if opts.topic.is_some() && !matches!(format, Format::RosBag | Format::Rosbag2) {
+        return option_error("a topic can be named only for ROS bags");
+    }
+    if opts.chip.is_some() && format != Format::Aedat2 {
+        return option_error("a chip can be named only for jAER AEDAT 2.0 files");
+    }
+    Ok(())
+}
+
+/// The reader as every caller gets it: the camera asked for checked, damage and wild times
+/// guarded, AEDAT4 read ahead.
+fn finish(
+    reader: Box<dyn EventReader>,
+    format: Format,
+    path: &Path,
+    opts: &OpenOptions,
+) -> Result<Box<dyn EventReader>> {
+    let option_error = |reason: String| EventError::Unfit {
+        path: path.to_path_buf(),
+        reason,
     };
     if let Some(c) = opts.camera {
         let n = reader.info().cameras.len().max(1);
@@ -408,7 +471,7 @@ pub fn open_source_with(
     // consumer's work overlap with them (about 5 % off a 60 s LZ4 extraction); the word
     // formats decode on one core in small batches, where handing batches across threads
     // cost more than it saved (7–20 % slower), so they are read in line
-    if probed.format == Format::Aedat4 {
+    if format == Format::Aedat4 {
         return prefetch::read_ahead(Box::new(guarded), path);
     }
     Ok(Box::new(guarded))

@@ -4,14 +4,7 @@
 //! (op 3) points at the index section, whose connection records (op 7) name every topic and its
 //! type; messages (op 2) sit in chunks (op 5), uncompressed, bz2 or lz4 (frame format).
 //!
-//! Messages read (ROS 1 serialisation: little-endian, no padding):
-//! - `dvs_msgs/EventArray` and `prophesee_event_msgs/EventArray`: a header, `u32` height and
-//!   width, then events of `u16 x, u16 y, time ts (u32 s, u32 ns), u8 polarity`; times are the
-//!   ROS stamps, in µs;
-//! - `event_camera_msgs/EventPacket` and `event_array_msgs/EventArray`: a header, `u32` height
-//!   and width, `u64` seq and time base, the encoding, `u8` is_bigendian, and the camera's own
-//!   bytes; `evt3` goes through the EVT 3.0 decoder, whose state (the 24-bit clock's loops)
-//!   carries from one message to the next.
+//! The messages are those of [`crate::rosmsg`], in the ROS 1 serialisation.
 //!
 //! The first topic of an event type is read, or the one [`crate::OpenOptions::topic`] names.
 //! Sizes read from the file bound reads (never allocations): a chunk can hold no more than
@@ -22,8 +15,7 @@ use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use crate::error::{io_err, EventError, Result};
-use crate::prophesee::Evt3;
-use crate::stream::WordDecoder;
+use crate::rosmsg::{kind_of, MessageDecoder, Serialization};
 use crate::{EventBatch, EventReader, Source, StreamDesc, StreamInfo};
 
 /// The line every ROS 1 bag starts with.
@@ -37,24 +29,8 @@ pub const MAX_CHUNK: u64 = 1 << 30;
 const OP_MSG_DATA: u8 = 0x02;
 const OP_BAG_HEADER: u8 = 0x03;
 const OP_CHUNK: u8 = 0x05;
+const OP_CHUNK_INFO: u8 = 0x06;
 const OP_CONNECTION: u8 = 0x07;
-
-/// The message types read, and how.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Kind {
-    /// An array of events with their own stamps (dvs_msgs, prophesee_event_msgs).
-    Events,
-    /// A packet of a camera's encoding (event_camera_msgs, event_array_msgs).
-    Packet,
-}
-
-fn kind_of(msg_type: &str) -> Option<Kind> {
-    match msg_type {
-        "dvs_msgs/EventArray" | "prophesee_event_msgs/EventArray" => Some(Kind::Events),
-        "event_camera_msgs/EventPacket" | "event_array_msgs/EventArray" => Some(Kind::Packet),
-        _ => None,
-    }
-}
 
 /// The header fields of a record.
 fn fields(h: &[u8]) -> HashMap<&[u8], &[u8]> {
@@ -82,49 +58,6 @@ fn u32_of(f: &HashMap<&[u8], &[u8]>, name: &[u8]) -> Option<u32> {
 fn u64_of(f: &HashMap<&[u8], &[u8]>, name: &[u8]) -> Option<u64> {
     let v = f.get(name)?;
     Some(u64::from_le_bytes(v.get(..8)?.try_into().ok()?))
-}
-
-/// A little-endian cursor over one message's bytes.
-struct Msg<'a> {
-    b: &'a [u8],
-    i: usize,
-}
-
-impl<'a> Msg<'a> {
-    fn take(&mut self, n: usize) -> std::result::Result<&'a [u8], String> {
-        let s = self
-            .b
-            .get(self.i..self.i.saturating_add(n))
-            .ok_or_else(|| {
-                format!(
-                    "a message cut short ({} bytes, {} more wanted)",
-                    self.b.len(),
-                    n
-                )
-            })?;
-        self.i += n;
-        Ok(s)
-    }
-    fn u32(&mut self) -> std::result::Result<u32, String> {
-        Ok(u32::from_le_bytes(
-            self.take(4)?.try_into().unwrap_or_default(),
-        ))
-    }
-    fn u64(&mut self) -> std::result::Result<u64, String> {
-        Ok(u64::from_le_bytes(
-            self.take(8)?.try_into().unwrap_or_default(),
-        ))
-    }
-    fn string(&mut self) -> std::result::Result<&'a [u8], String> {
-        let n = self.u32()? as usize;
-        self.take(n)
-    }
-    /// `std_msgs/Header`: seq, stamp, frame_id.
-    fn header(&mut self) -> std::result::Result<(), String> {
-        self.take(12)?;
-        self.string()?;
-        Ok(())
-    }
 }
 
 /// A record read from the file: its header fields and its data.
@@ -248,14 +181,12 @@ pub struct BagReader {
     chunk_at: u64,
     /// Connection ids of the topic read, and how its messages are decoded.
     conns: Vec<u32>,
-    kind: Kind,
-    evt3: Evt3,
+    decoder: MessageDecoder,
     info: StreamInfo,
     /// The first batch, read on opening (the sensor's size is in the messages).
     pending: Option<EventBatch>,
     failed: Option<EventError>,
     done: bool,
-    other_encodings: u64,
 }
 
 /// A reader of the event topic of the bag in `src` (named `path`): `topic`, or the first topic
@@ -291,6 +222,8 @@ pub fn reader(
     let index_pos = u64_of(&hf, b"index_pos").unwrap_or(0);
     // the connections, from the index section when the bag was closed properly
     let mut topics: Vec<(u32, Topic)> = Vec::new();
+    // messages by connection, from the chunk info records (op 6) after the connections
+    let mut counts: Option<HashMap<u32, u64>> = None;
     if index_pos > first_record && index_pos < len {
         r.seek(SeekFrom::Start(index_pos)).map_err(io)?;
         let mut at = index_pos;
@@ -299,6 +232,14 @@ pub fn reader(
             if rec.op == OP_CONNECTION {
                 if let Some(t) = connection(&rec) {
                     topics.push(t);
+                }
+            }
+            if rec.op == OP_CHUNK_INFO {
+                let counts = counts.get_or_insert_with(HashMap::new);
+                for pair in rec.data.chunks_exact(8) {
+                    let conn = u32::from_le_bytes([pair[0], pair[1], pair[2], pair[3]]);
+                    let n = u32::from_le_bytes([pair[4], pair[5], pair[6], pair[7]]);
+                    *counts.entry(conn).or_insert(0) += n as u64;
                 }
             }
         }
@@ -323,7 +264,7 @@ pub fn reader(
             reason: match topic {
                 Some(name) => format!("no topic {name:?} in the bag; it has: {}", listing()),
                 None if topics.is_empty() => "a bag without an index (not closed properly): give --topic, or reindex it with `rosbag reindex`".into(),
-                None => format!("no topic of event messages (dvs_msgs/EventArray, prophesee_event_msgs/EventArray, event_camera_msgs/EventPacket) in the bag; it has: {}", listing()),
+                None => format!("no topic of event messages ({}) in the bag; it has: {}", crate::rosmsg::TYPES, listing()),
             },
         });
     };
@@ -344,13 +285,14 @@ pub fn reader(
         .collect();
     let info = StreamInfo {
         format: FORMAT,
-        codec: Some(format!("{} on {}", first.msg_type, name)),
+        within: Some(format!("topic {} ({})", name, first.msg_type)),
         streams: topics
             .iter()
             .map(|(c, t)| StreamDesc {
                 id: *c as i32,
                 kind: t.msg_type.clone(),
                 source: Some(t.name.clone()),
+                messages: counts.as_ref().map(|n| n.get(c).copied().unwrap_or(0)),
                 ..StreamDesc::default()
             })
             .collect(),
@@ -370,13 +312,11 @@ pub fn reader(
         in_chunk: 0,
         chunk_at: first_record,
         conns,
-        kind,
-        evt3: Evt3::default(),
+        decoder: MessageDecoder::new(kind),
         info,
         pending: None,
         failed: None,
         done: false,
-        other_encodings: 0,
     };
     // the sensor's size comes with the first message: read it now, hand it out first
     match bag.read_batch() {
@@ -398,54 +338,6 @@ fn connection(rec: &Record) -> Option<(u32, Topic)> {
 }
 
 impl BagReader {
-    /// Decodes one message of the topic into `out`.
-    fn message(&mut self, data: &[u8], out: &mut EventBatch) -> std::result::Result<(), String> {
-        let mut m = Msg { b: data, i: 0 };
-        m.header()?;
-        let height = m.u32()?;
-        let width = m.u32()?;
-        if self.info.width.is_none() && width > 0 && width <= u16::MAX as u32 {
-            self.info.width = Some(width as u16);
-            self.info.height = Some(height.min(u16::MAX as u32) as u16);
-        }
-        match self.kind {
-            Kind::Events => {
-                let n = m.u32()? as usize;
-                let bytes = m.take(n.checked_mul(13).ok_or("an event count beyond reason")?)?;
-                for e in bytes.chunks_exact(13) {
-                    let s = u32::from_le_bytes([e[4], e[5], e[6], e[7]]) as i64;
-                    let ns = u32::from_le_bytes([e[8], e[9], e[10], e[11]]) as i64;
-                    out.push(
-                        s * 1_000_000 + ns / 1000,
-                        u16::from_le_bytes([e[0], e[1]]),
-                        u16::from_le_bytes([e[2], e[3]]),
-                        e[12] != 0,
-                    );
-                }
-            }
-            Kind::Packet => {
-                m.u64()?; // seq
-                m.u64()?; // time base
-                let encoding = m.string()?;
-                m.take(1)?; // is_bigendian
-                let bytes = m.string()?;
-                match encoding {
-                    b"evt3" => self.evt3.decode(&bytes[..bytes.len() / 2 * 2], out)?,
-                    _ => {
-                        self.other_encodings += 1;
-                        if self.other_encodings == 1 {
-                            return Err(format!(
-                                "packets in the {:?} encoding, which eenf does not read yet (it reads evt3)",
-                                String::from_utf8_lossy(encoding)
-                            ));
-                        }
-                    }
-                }
-            }
-        }
-        Ok(())
-    }
-
     fn fail(&mut self, e: EventError, batch: EventBatch) -> Result<Option<EventBatch>> {
         self.done = true;
         if batch.is_empty() {
@@ -453,6 +345,17 @@ impl BagReader {
         }
         self.failed = Some(e);
         Ok(Some(batch))
+    }
+}
+
+impl BagReader {
+    /// The sensor's size, once a message gave it.
+    fn note_size(&mut self) {
+        if self.info.width.is_none() {
+            self.info.width = self.decoder.width;
+            self.info.height = self.decoder.height;
+        }
+        self.decoder.describe(&mut self.info.within);
     }
 }
 
@@ -476,7 +379,7 @@ impl EventReader for BagReader {
     }
 
     fn skipped(&self) -> Vec<(&'static str, u64)> {
-        self.evt3.skipped()
+        self.decoder.skipped()
     }
 }
 
@@ -499,7 +402,11 @@ impl BagReader {
                 if rec.op == OP_MSG_DATA {
                     let conn = u32_of(&fields(&rec.header), b"conn");
                     if conn.is_some_and(|c| self.conns.contains(&c)) {
-                        if let Err(reason) = self.message(&rec.data, &mut batch) {
+                        let decoded =
+                            self.decoder
+                                .decode(&rec.data, Serialization::Ros1, &mut batch);
+                        self.note_size();
+                        if let Err(reason) = decoded {
                             let e = EventError::Corrupt {
                                 path: self.path.clone(),
                                 format: FORMAT,

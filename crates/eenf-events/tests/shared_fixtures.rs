@@ -188,7 +188,13 @@ fn real_prophesee_files_match_the_reference_decoders() {
 fn every_fixture_survives_truncation_and_bit_flips() {
     let dir = tempfile::tempdir().unwrap();
     let mut files = Vec::new();
-    for sub in ["synthetic", "real", "containers/other", "containers/ros1"] {
+    for sub in [
+        "synthetic",
+        "real",
+        "containers/other",
+        "containers/ros1",
+        "containers/hdf5",
+    ] {
         for e in std::fs::read_dir(shared().join("fixtures").join(sub)).unwrap() {
             let p = e.unwrap().path();
             if p.extension().map(|e| e != "csv").unwrap_or(false) {
@@ -196,7 +202,16 @@ fn every_fixture_survives_truncation_and_bit_flips() {
             }
         }
     }
-    assert!(files.len() >= 23, "{files:?}");
+    // rosbag2 storage files, damaged on their own
+    for e in std::fs::read_dir(shared().join("fixtures/containers/ros2")).unwrap() {
+        for f in std::fs::read_dir(e.unwrap().path()).unwrap() {
+            let p = f.unwrap().path();
+            if p.extension().is_some_and(|e| e == "db3" || e == "mcap") {
+                files.push(p);
+            }
+        }
+    }
+    assert!(files.len() >= 37, "{files:?}");
     for path in files {
         let bytes = std::fs::read(&path).unwrap();
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
@@ -288,13 +303,7 @@ fn ros1_bags_decode_as_their_readme_says() {
     );
     // the dvs_msgs and prophesee_event_msgs bags hold its first 38,478 events in time order,
     // stamped in ROS time: the same events, shifted by one constant
-    let mut first = packets.clone();
-    first.truncate(0);
-    let mut order: Vec<usize> = (0..packets.len()).collect();
-    order.sort_by_key(|&i| packets.t[i]);
-    for &i in order.iter().take(38_478) {
-        first.push(packets.t[i], packets.x[i], packets.y[i], packets.p[i]);
-    }
+    let first = first_in_time(&packets, 38_478);
     for name in ["ros1_dvs_msgs.bag", "ros1_prophesee_event_msgs.bag"] {
         let b = read_all(&ros1.join(name));
         assert_eq!(b.len(), 38_478, "{name}");
@@ -304,4 +313,146 @@ fn ros1_bags_decode_as_their_readme_says() {
         shifted.t.iter_mut().for_each(|t| *t -= shift);
         assert_eq!(canonical(&shifted), canonical(&first), "{name}");
     }
+}
+
+/// The events of `b` in time order (a stable sort), the first `n` of them.
+fn first_in_time(b: &EventBatch, n: usize) -> EventBatch {
+    let mut order: Vec<usize> = (0..b.len()).collect();
+    order.sort_by_key(|&i| b.t[i]);
+    let mut out = EventBatch::default();
+    for &i in order.iter().take(n) {
+        out.push(b.t[i], b.x[i], b.y[i], b.p[i]);
+    }
+    out
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn rosbag2_folders_decode_as_their_readme_says() {
+    let ros2 = shared().join("fixtures/containers/ros2");
+    let bag1 =
+        read_all(&shared().join("fixtures/containers/ros1/event_camera_py_test_events_1.bag"));
+    // the same recording as a rosbag2 (SQLite v8): its folder and its .db3 give the ROS 1
+    // bag's events, one by one
+    let folder = ros2.join("event_camera_py_test_events_1");
+    for path in [folder.clone(), folder.join("test_events_1.db3")] {
+        let mut r = open(&path).unwrap();
+        assert_eq!(r.info().format, "rosbag2 (SQLite)");
+        let topics: Vec<_> = r
+            .info()
+            .streams
+            .iter()
+            .map(|s| (s.source.clone(), s.messages))
+            .collect();
+        assert_eq!(
+            topics,
+            vec![(Some("/event_camera/events".into()), Some(517))]
+        );
+        let mut b = EventBatch::default();
+        while let Some(x) = r.next_batch().unwrap() {
+            b.extend_from(&x);
+        }
+        assert_eq!(b, bag1, "{}", path.display());
+        assert!(
+            r.skipped().contains(&("trigger", 4_157)),
+            "{:?}",
+            r.skipped()
+        );
+    }
+    // MCAP (ros2idl), libcaer_cmp from a DAVIS346: the upstream test's counts, Unix times
+    let path = ros2.join("event_camera_py_test_events_2");
+    let r = open(&path).unwrap();
+    assert_eq!(r.info().format, "rosbag2 (MCAP)");
+    assert_eq!((r.info().width, r.info().height), (Some(346), Some(260)));
+    let b = read_all(&path);
+    let (n, on, t0, t1, ..) = summary(&b);
+    assert_eq!((n, on, n - on), (571_266, 211_043, 360_223));
+    // 2025-04-09T00:00:00Z, and within a second of it
+    assert!(
+        t0 >= 1_744_156_800_000_000 && t1 - t0 < 86_400_000_000,
+        "{t0} {t1}"
+    );
+    assert!(b.x.iter().all(|&x| x < 346) && b.y.iter().all(|&y| y < 260));
+    // event_camera_codecs' own test data: evt3 with triggers (sums in ns)
+    let b = read_all(&ros2.join("codecs_evt3_trigger"));
+    let (n, on, _, _, sx, sy) = summary(&b);
+    let st: i128 = b.t.iter().map(|&t| t as i128 * 1000).sum();
+    assert_eq!(
+        (n, on, sx, sy, st),
+        (
+            82_469,
+            41_439,
+            42_078_718,
+            31_656_267,
+            1_222_326_831_810_000
+        )
+    );
+    // libcaer: the 31-bit clock wraps, time goes on
+    let b = read_all(&ros2.join("codecs_libcaer_rollover"));
+    let (n, on, t0, t1, sx, sy) = summary(&b);
+    assert_eq!((n, on, sx, sy), (334_331, 181_908, 111_651_612, 82_801_007));
+    assert!(b.t.windows(2).all(|w| w[1] >= w[0]), "time goes back");
+    assert!(t1 - t0 < 10_000_000, "{t0} {t1}");
+    // mono (event_array_msgs, SQLite v4)
+    let b = read_all(&ros2.join("codecs_mono_cd"));
+    let (n, on, _, _, sx, sy) = summary(&b);
+    let st: i64 = b.t.iter().map(|&t| t * 1000).sum();
+    assert_eq!((n, on, sx, sy, st), (100, 50, 34_450, 26_450, 4_950_000));
+    // ROS 2 dvs_msgs (CDR, fields aligned) in SQLite and in MCAP: the recording's first
+    // 14,862 events in time order, stamped in ROS time
+    let first = first_in_time(&bag1, 14_862);
+    for name in ["ros2_dvs_msgs_sqlite3", "ros2_dvs_msgs_mcap"] {
+        let b = read_all(&ros2.join(name));
+        assert_eq!(b.len(), 14_862, "{name}");
+        let shift = b.t[0] - first.t[0];
+        assert!(shift > 1_600_000_000_000_000, "{name}: ROS stamps, µs");
+        let mut shifted = b.clone();
+        shifted.t.iter_mut().for_each(|t| *t -= shift);
+        assert_eq!(canonical(&shifted), canonical(&first), "{name}");
+    }
+}
+
+#[test]
+#[ignore = "needs ../shared"]
+fn hdf5_layouts_decode_as_their_readme_says() {
+    let h5 = shared().join("fixtures/containers/hdf5");
+    let bag1 =
+        read_all(&shared().join("fixtures/containers/ros1/event_camera_py_test_events_1.bag"));
+    let first = first_in_time(&bag1, 38_478);
+    let from_zero = |b: &EventBatch| {
+        let mut z = b.clone();
+        z.t.iter_mut().for_each(|t| *t -= first.t[0]);
+        z
+    };
+    // DSEC: every filter (blosc + zstd as DSEC, zstd 32015, deflate); t = t_offset + t
+    for name in [
+        "dsec_layout_blosc_zstd.h5",
+        "dsec_layout_zstd32015.h5",
+        "dsec_layout_gzip.h5",
+    ] {
+        let b = read_all(&h5.join(name));
+        assert_eq!(canonical(&b), canonical(&first), "{name}");
+    }
+    // M3ED (blosc) and Prophesee's CD/events (deflate): times from 0
+    for name in ["m3ed_layout_blosc.h5", "prophesee_cd_layout_gzip.h5"] {
+        let b = read_all(&h5.join(name));
+        assert_eq!(canonical(&b), canonical(&from_zero(&first)), "{name}");
+    }
+    let r = open(&h5.join("prophesee_cd_layout_gzip.h5")).unwrap();
+    assert_eq!((r.info().width, r.info().height), (Some(640), Some(480)));
+    // MVSEC: N×4 float64, t in seconds (float64 keeps Unix µs to within one)
+    let b = read_all(&h5.join("mvsec_layout.h5"));
+    assert_eq!(b.len(), 38_478);
+    let shift = b.t[0] - first.t[0];
+    assert!(shift > 1_600_000_000_000_000, "Unix seconds, as µs");
+    let mut got = canonical(&b);
+    let want = canonical(&first);
+    for (g, w) in got.iter_mut().zip(&want) {
+        assert!((g.0 - shift - w.0).abs() <= 1, "{g:?} {w:?}");
+        g.0 = w.0;
+    }
+    assert_eq!(got, want);
+    // Prophesee's ECF: all 343,474 CD events of the recording
+    let b = read_all(&h5.join("prophesee_ecf_layout.hdf5"));
+    assert_eq!(canonical(&b), canonical(&bag1));
 }

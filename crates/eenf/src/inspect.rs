@@ -128,7 +128,7 @@ impl Inspection {
             .iter()
             .map(|s| {
                 serde_json::json!({"id": s.id, "type": s.kind, "width": s.width,
-                    "height": s.height, "source": s.source})
+                    "height": s.height, "source": s.source, "messages": s.messages})
             })
             .collect();
         let skipped: std::collections::BTreeMap<String, u64> = self
@@ -137,7 +137,7 @@ impl Inspection {
             .map(|(k, n)| (k.to_string(), *n))
             .collect();
         serde_json::json!({
-            "file": file, "format": info.format, "codec": info.codec,
+            "file": file, "format": info.format, "codec": info.codec, "within": info.within,
             "width": width, "height": height, "streams": streams, "indexed": info.indexed,
             "events": stats.events, "on_events": stats.on,
             "first_t_us": stats.first_t, "last_t_us": stats.last_t,

@@ -63,15 +63,32 @@ pub fn run(a: Args) -> Result<()> {
     let (duration_s, rate) = found.duration_and_rate();
     let (width, height) = found.resolution();
     outln!("file        {}", a.file.display());
-    match &info.codec {
-        Some(c) => outln!("format      {} (compression {c})", info.format),
-        None => outln!("format      {}", info.format),
+    match (&info.codec, &info.within) {
+        (_, Some(w)) => outln!("format      {}, {w}", info.format),
+        (Some(c), None) => outln!("format      {} (compression {c})", info.format),
+        (None, None) => outln!("format      {}", info.format),
     }
     match (width, height) {
         (Some(w), Some(h)) => outln!("resolution  {w} x {h}"),
         _ => outln!("resolution  unknown"),
     }
-    if !info.streams.is_empty() {
+    let topics: Vec<String> = info
+        .streams
+        .iter()
+        .filter_map(|s| {
+            let name = s
+                .source
+                .as_ref()
+                .filter(|_| s.messages.is_some() || info.within.is_some())?;
+            Some(match s.messages {
+                Some(n) => format!("{name} {} ({n} messages)", s.kind),
+                None => format!("{name} {}", s.kind),
+            })
+        })
+        .collect();
+    if !topics.is_empty() {
+        outln!("topics      {}", topics.join("; "));
+    } else if !info.streams.is_empty() {
         let list: Vec<String> = info
             .streams
             .iter()

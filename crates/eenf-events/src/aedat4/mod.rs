@@ -141,10 +141,7 @@ fn parse_streams(xml: &str) -> Vec<StreamDesc> {
                     None => {
                         streams.push(StreamDesc {
                             id,
-                            kind: String::new(),
-                            width: None,
-                            height: None,
-                            source: None,
+                            ..StreamDesc::default()
                         });
                         streams.len() - 1
                     }

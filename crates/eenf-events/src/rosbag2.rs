@@ -1,0 +1,1069 @@
+//! rosbag2 recordings (<https://github.com/ros2/rosbag2>) of event messages: a folder holding
+//! `metadata.yaml` and one or more storage files, read in the order the metadata lists them
+//! (else by name). A storage file opens on its own too:
+//! - SQLite (`.db3`, metadata versions 4 to 8): table `topics` (id, name, type,
+//!   serialization_format) and table `messages` (id, topic_id, timestamp, data), read in the
+//!   order they were written (by id), a page at a time;
+//! - MCAP (`.mcap`, <https://mcap.dev/spec>): read as a stream by the `mcap` crate's sans-io
+//!   reader (chunks uncompressed, zstd or lz4); the summary at the end, when the file has one,
+//!   names the topics and counts their messages before any is read.
+//!
+//! Files compressed whole (`.db3.zstd`, `.mcap.zstd`) are expanded to a temporary file first;
+//! messages compressed one by one (zstd) are expanded as they are read. The messages are those
+//! of [`crate::rosmsg`], in CDR (or the ROS 1 serialisation, in an MCAP that says `ros1`).
+
+use std::collections::{HashMap, VecDeque};
+use std::io::{Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{sync_channel, Receiver};
+use std::sync::{Arc, OnceLock};
+
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+use mcap::sans_io::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
+
+use crate::error::{io_err, EventError, Result};
+use crate::rosmsg::{kind_of, MessageDecoder, Serialization, TYPES};
+use crate::{EventBatch, EventReader, Source, StreamDesc, StreamInfo};
+
+/// The first bytes of an SQLite database.
+pub const SQLITE_MAGIC: &[u8] = b"SQLite format 3\0";
+/// The first bytes of an MCAP file.
+pub const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
+/// The first bytes of a zstd frame.
+const ZSTD_MAGIC: &[u8] = &[0x28, 0xB5, 0x2F, 0xFD];
+const SQLITE: &str = "rosbag2 (SQLite)";
+const MCAP: &str = "rosbag2 (MCAP)";
+/// The largest message (or MCAP record) accepted, expanded.
+pub const MAX_MESSAGE: usize = 1 << 30;
+/// Messages fetched from SQLite at a time.
+const PAGE: usize = 64;
+
+/// True when `dir` looks like a rosbag2 folder: it holds a storage file or `metadata.yaml`.
+pub fn is_folder(dir: &Path) -> bool {
+    dir.join("metadata.yaml").is_file() || storage_files(dir).is_ok_and(|f| !f.is_empty())
+}
+
+/// The storage files of the rosbag2 folder `dir`, in the order the metadata lists them, else
+/// by name.
+pub fn storage_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let io = |e| io_err(dir, e);
+    if let Ok(yaml) = std::fs::read_to_string(dir.join("metadata.yaml")) {
+        let listed = listed_files(&yaml);
+        if !listed.is_empty() {
+            return Ok(listed.iter().map(|f| dir.join(f)).collect());
+        }
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(io)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            let name = name.strip_suffix(".zstd").unwrap_or(name);
+            p.is_file() && (name.ends_with(".db3") || name.ends_with(".mcap"))
+        })
+        .collect();
+    // split bags number their files: name_0, name_1, … name_10 in numeric order
+    files.sort_by_key(|p| {
+        let stem = p
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("")
+            .to_string();
+        let digits: String = stem
+            .split('.')
+            .next()
+            .unwrap_or("")
+            .rsplit('_')
+            .next()
+            .unwrap_or("")
+            .chars()
+            .filter(char::is_ascii_digit)
+            .collect();
+        (digits.parse::<u64>().unwrap_or(0), stem)
+    });
+    Ok(files)
+}
+
+/// The items of `relative_file_paths:` in a rosbag2 `metadata.yaml`.
+fn listed_files(yaml: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut lines = yaml
+        .lines()
+        .skip_while(|l| l.trim() != "relative_file_paths:");
+    let Some(key) = lines.next() else {
+        return out;
+    };
+    let indent = key.len() - key.trim_start().len();
+    for l in lines {
+        let t = l.trim_start();
+        let this = l.len() - t.len();
+        match t.strip_prefix("- ") {
+            Some(item) if this >= indent => {
+                out.push(item.trim().trim_matches(['"', '\'']).to_string())
+            }
+            _ => break,
+        }
+    }
+    out
+}
+
+/// A topic of a bag.
+#[derive(Debug, Clone)]
+struct Topic {
+    /// SQLite topic id or MCAP channel id.
+    id: i64,
+    name: String,
+    msg_type: String,
+    serialization: String,
+    count: Option<u64>,
+}
+
+/// One storage file, read message by message for one topic.
+enum Storage {
+    Sqlite(SqliteFile),
+    Mcap(McapFile),
+}
+
+/// An SQLite storage file.
+struct SqliteFile {
+    db: rusqlite::Connection,
+    /// Keeps a copy of what could not be opened by name (stdin, a `.zstd` file) alive.
+    _copy: Option<tempfile::TempPath>,
+    topic: Option<i64>,
+    entry: Option<Topic>,
+    last_id: i64,
+    page: VecDeque<Vec<u8>>,
+    ended: bool,
+}
+
+/// An MCAP storage file.
+struct McapFile {
+    src: Box<dyn Source>,
+    reader: LinearReader,
+    /// Channel id → topic; schema id → type name.
+    channels: HashMap<u16, Topic>,
+    schemas: HashMap<u16, String>,
+    _copy: Option<tempfile::TempPath>,
+}
+
+/// Messages of the chosen topic, and what the choice needs to know.
+struct Chosen {
+    name: String,
+    serialization: Serialization,
+}
+
+/// The reader of one topic of a rosbag2.
+pub struct Rosbag2Reader {
+    path: PathBuf,
+    files: Vec<PathBuf>,
+    next_file: usize,
+    storage: Option<Storage>,
+    /// The storage file being read, on a thread of its own.
+    feed: Option<Receiver<Fed>>,
+    format: &'static str,
+    /// The topic asked for, then the topic read.
+    wanted: Option<String>,
+    chosen: Option<Chosen>,
+    /// The chosen topic's name, for the thread that reads the file.
+    chosen_name: Arc<OnceLock<String>>,
+    /// The topics that messages came from (an MCAP without a summary names no others).
+    seen: Vec<Topic>,
+    decoder: Option<MessageDecoder>,
+    info: StreamInfo,
+    pending: Option<EventBatch>,
+    failed: Option<EventError>,
+    done: bool,
+    messages: u64,
+    /// The topics of the first file, kept when it ends (an MCAP without a summary names them
+    /// only as they come).
+    first_topics: Vec<Topic>,
+}
+
+/// A reader of the rosbag2 folder `dir`: its topic `topic`, or its first topic of event
+/// messages.
+pub fn folder(dir: &Path, topic: Option<&str>) -> Result<Box<dyn EventReader>> {
+    let files = storage_files(dir)?;
+    if files.is_empty() {
+        return Err(EventError::UnknownFormat {
+            path: dir.to_path_buf(),
+            reason: "a folder without rosbag2 storage files (.db3, .mcap)".into(),
+            supported: crate::SUPPORTED,
+        });
+    }
+    start(dir, files, None, topic)
+}
+
+/// A reader of the rosbag2 storage file in `src` (named `path`).
+pub fn reader(
+    src: Box<dyn Source>,
+    path: &Path,
+    topic: Option<&str>,
+) -> Result<Box<dyn EventReader>> {
+    start(path, vec![path.to_path_buf()], Some(src), topic)
+}
+
+fn start(
+    path: &Path,
+    files: Vec<PathBuf>,
+    first: Option<Box<dyn Source>>,
+    topic: Option<&str>,
+) -> Result<Box<dyn EventReader>> {
+    let mut r = Rosbag2Reader {
+        path: path.to_path_buf(),
+        files,
+        next_file: 0,
+        storage: None,
+        feed: None,
+        format: SQLITE,
+        wanted: topic.map(str::to_string),
+        chosen: None,
+        chosen_name: Arc::new(OnceLock::new()),
+        seen: Vec::new(),
+        decoder: None,
+        info: StreamInfo::default(),
+        pending: None,
+        failed: None,
+        done: false,
+        messages: 0,
+        first_topics: Vec::new(),
+    };
+    r.open_next(first)?;
+    r.info.format = r.format;
+    let topics = r.topics();
+    if r.storage.is_some() {
+        r.choose(&topics)?;
+    }
+    // the sensor's size comes with the first message: read it now, hand it out first
+    match r.read_batch() {
+        Ok(b) => r.pending = b,
+        Err(e) => r.failed = Some(e),
+    }
+    // an MCAP without a summary: the channels seen so far
+    let topics = match (topics.is_empty(), r.first_topics.is_empty()) {
+        (false, _) => topics,
+        (true, true) => r.topics(),
+        (true, false) => r.first_topics.clone(),
+    };
+    if r.chosen.is_none() && r.failed.is_none() {
+        return Err(r.no_topic(&topics));
+    }
+    r.info.streams = topics
+        .iter()
+        .map(|t| StreamDesc {
+            id: t.id as i32,
+            kind: t.msg_type.clone(),
+            source: Some(t.name.clone()),
+            messages: t.count,
+            ..StreamDesc::default()
+        })
+        .collect();
+    Ok(Box::new(r))
+}
+
+impl Rosbag2Reader {
+    /// Opens the next storage file (`src`: the first one, already open).
+    fn open_next(&mut self, src: Option<Box<dyn Source>>) -> Result<bool> {
+        let Some(file) = self.files.get(self.next_file).cloned() else {
+            self.storage = None;
+            return Ok(false);
+        };
+        self.next_file += 1;
+        let io = |e| io_err(&file, e);
+        let mut src = match src {
+            Some(s) => s,
+            None => crate::open_file(&file)?,
+        };
+        let mut head = [0u8; 16];
+        let n = read_full(&mut src, &mut head).map_err(io)?;
+        src.seek(SeekFrom::Start(0)).map_err(io)?;
+        let head = &head[..n];
+        let mut copy = None;
+        if head.starts_with(ZSTD_MAGIC) {
+            // a file compressed whole: expanded beside the other temporary files
+            let mut tmp = tempfile::NamedTempFile::new().map_err(io)?;
+            let mut z = zstd::stream::read::Decoder::new(src).map_err(io)?;
+            std::io::copy(&mut z, tmp.as_file_mut()).map_err(|e| EventError::Damaged {
+                path: file.clone(),
+                format: "rosbag2 (zstd file)",
+                reason: format!("it does not expand: {e}"),
+            })?;
+            let mut f = tmp.reopen().map_err(io)?;
+            f.seek(SeekFrom::Start(0)).map_err(io)?;
+            copy = Some(tmp.into_temp_path());
+            src = Box::new(f);
+            return self.open_storage(&file, src, copy);
+        }
+        if !head.starts_with(SQLITE_MAGIC) && !head.starts_with(MCAP_MAGIC) {
+            return Err(EventError::UnknownFormat {
+                path: file,
+                reason: "a rosbag2 storage file that is neither SQLite nor MCAP".into(),
+                supported: crate::SUPPORTED,
+            });
+        }
+        if head.starts_with(SQLITE_MAGIC) && !std::fs::metadata(&file).is_ok_and(|m| m.is_file()) {
+            // SQLite opens files by name: a pipe's content goes to a named temporary file
+            let mut tmp = tempfile::NamedTempFile::new().map_err(io)?;
+            std::io::copy(&mut src, tmp.as_file_mut()).map_err(io)?;
+            copy = Some(tmp.into_temp_path());
+        }
+        self.open_storage(&file, src, copy)
+    }
+
+    fn open_storage(
+        &mut self,
+        file: &Path,
+        mut src: Box<dyn Source>,
+        copy: Option<tempfile::TempPath>,
+    ) -> Result<bool> {
+        let io = |e| io_err(file, e);
+        let mut head = [0u8; 16];
+        let n = read_full(&mut src, &mut head).map_err(io)?;
+        src.seek(SeekFrom::Start(0)).map_err(io)?;
+        if head[..n].starts_with(MCAP_MAGIC) {
+            self.format = MCAP;
+            let mut m = McapFile {
+                src,
+                reader: LinearReader::new_with_options(
+                    LinearReaderOptions::default().with_record_length_limit(MAX_MESSAGE),
+                ),
+                channels: HashMap::new(),
+                schemas: HashMap::new(),
+                _copy: copy,
+            };
+            m.read_summary();
+            self.storage = Some(Storage::Mcap(m));
+            return Ok(true);
+        }
+        self.format = SQLITE;
+        let name: &Path = copy.as_deref().unwrap_or(file);
+        let damaged = |e: rusqlite::Error| EventError::Damaged {
+            path: file.to_path_buf(),
+            format: SQLITE,
+            reason: e.to_string(),
+        };
+        // immutable: read-only folders open, and nothing (a journal, a lock) is written
+        let uri = format!(
+            "file:{}?immutable=1",
+            percent_path(&std::path::absolute(name).map_err(io)?)
+        );
+        let db = rusqlite::Connection::open_with_flags(
+            uri,
+            rusqlite::OpenFlags::SQLITE_OPEN_READ_ONLY
+                | rusqlite::OpenFlags::SQLITE_OPEN_URI
+                | rusqlite::OpenFlags::SQLITE_OPEN_NO_MUTEX,
+        )
+        .map_err(damaged)?;
+        let has_topics: bool = db
+            .query_row(
+                "SELECT count(*) FROM sqlite_master WHERE type='table' AND name IN ('topics','messages')",
+                [],
+                |r| r.get::<_, i64>(0),
+            )
+            .map_err(damaged)?
+            == 2;
+        if !has_topics {
+            return Err(EventError::Unfit {
+                path: file.to_path_buf(),
+                reason: "an SQLite database without the tables of a rosbag2 (topics, messages)"
+                    .into(),
+            });
+        }
+        self.storage = Some(Storage::Sqlite(SqliteFile {
+            db,
+            _copy: copy,
+            topic: None,
+            entry: None,
+            last_id: i64::MIN,
+            page: VecDeque::new(),
+            ended: false,
+        }));
+        Ok(true)
+    }
+
+    /// The topics of the storage file open now, with their message counts where known.
+    fn topics(&self) -> Vec<Topic> {
+        match &self.storage {
+            Some(Storage::Sqlite(s)) => s.topics().unwrap_or_default(),
+            Some(Storage::Mcap(m)) => {
+                let mut t: Vec<Topic> = m.channels.values().cloned().collect();
+                t.sort_by_key(|t| t.id);
+                t
+            }
+            None => Vec::new(),
+        }
+    }
+
+    /// Picks the topic to read from `topics` (of the first file).
+    fn choose(&mut self, topics: &[Topic]) -> Result<()> {
+        let pick = match &self.wanted {
+            Some(name) => topics.iter().find(|t| &t.name == name),
+            None => topics.iter().find(|t| kind_of(&t.msg_type).is_some()),
+        };
+        match pick {
+            Some(t) => self.take(t),
+            // an MCAP without a summary names its channels as they come
+            None if matches!(self.storage, Some(Storage::Mcap(_))) && topics.is_empty() => Ok(()),
+            None => Err(self.no_topic(topics)),
+        }
+    }
+
+    /// Reads topic `t` from now on.
+    fn take(&mut self, t: &Topic) -> Result<()> {
+        let Some(kind) = kind_of(&t.msg_type) else {
+            return Err(EventError::Unfit {
+                path: self.path.clone(),
+                reason: format!(
+                    "topic {} carries {}, not event messages eenf reads ({TYPES})",
+                    t.name, t.msg_type
+                ),
+            });
+        };
+        let serialization = match t.serialization.as_str() {
+            "cdr" | "" => Serialization::Cdr,
+            "ros1" => Serialization::Ros1,
+            other => {
+                return Err(EventError::Unfit {
+                    path: self.path.clone(),
+                    reason: format!(
+                        "topic {} is serialised as {other:?}; eenf reads cdr and ros1",
+                        t.name
+                    ),
+                })
+            }
+        };
+        self.info.within = Some(format!("topic {} ({})", t.name, t.msg_type));
+        let _ = self.chosen_name.set(t.name.clone());
+        self.chosen = Some(Chosen {
+            name: t.name.clone(),
+            serialization,
+        });
+        if self.decoder.is_none() {
+            self.decoder = Some(MessageDecoder::new(kind));
+        }
+        Ok(())
+    }
+
+    fn no_topic(&self, topics: &[Topic]) -> EventError {
+        let listing: Vec<String> = topics
+            .iter()
+            .map(|t| format!("{} ({})", t.name, t.msg_type))
+            .collect();
+        let has = if listing.is_empty() {
+            "no topics".to_string()
+        } else {
+            listing.join(", ")
+        };
+        EventError::Unfit {
+            path: self.path.clone(),
+            reason: match &self.wanted {
+                Some(name) => format!("no topic {name:?} in the bag; it has: {has}"),
+                None => format!("no topic of event messages ({TYPES}) in the bag; it has: {has}"),
+            },
+        }
+    }
+
+    /// The next message of the chosen topic, across the storage files (expanded, or why it
+    /// could not be); `None` at the end.
+    fn next_message(&mut self) -> Result<Option<std::result::Result<Vec<u8>, String>>> {
+        loop {
+            if self.feed.is_none() {
+                let Some(storage) = self.storage.take() else {
+                    return Ok(None);
+                };
+                let file = match self.next_file.checked_sub(1) {
+                    Some(i) => self.files[i].clone(),
+                    None => self.path.clone(),
+                };
+                self.feed = Some(feed(storage, file, self.chosen_name.clone()));
+            }
+            let got = match self.feed.as_ref().map(|rx| rx.recv()) {
+                Some(Ok(got)) => got,
+                // the thread ended without a word: taken as the end of the file
+                _ => Ok(None),
+            };
+            match got? {
+                Some((topic, data)) => {
+                    if !self.seen.iter().any(|t| t.id == topic.id) {
+                        self.seen.push(topic.clone());
+                    }
+                    if self.chosen.is_none() {
+                        // an MCAP without a summary: the first channel that fits is read
+                        let fits = match &self.wanted {
+                            Some(w) => &topic.name == w,
+                            None => kind_of(&topic.msg_type).is_some(),
+                        };
+                        if fits {
+                            self.take(&topic)?;
+                        }
+                    }
+                    if self.chosen.as_ref().is_some_and(|c| c.name == topic.name) {
+                        return Ok(Some(data));
+                    }
+                }
+                None => {
+                    self.feed = None;
+                    if self.next_file == 1 {
+                        self.first_topics = std::mem::take(&mut self.seen);
+                        self.first_topics.sort_by_key(|t| t.id);
+                    }
+                    if !self.open_next(None)? {
+                        return Ok(None);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The next batch of the topic's events, `None` at the end.
+    fn read_batch(&mut self) -> Result<Option<EventBatch>> {
+        let mut batch = EventBatch::default();
+        while batch.len() < 1 << 16 && !self.done {
+            let msg = match self.next_message() {
+                Ok(Some(m)) => m,
+                Ok(None) => {
+                    self.done = true;
+                    break;
+                }
+                Err(e) => return self.fail(e, batch),
+            };
+            self.messages += 1;
+            let data = match msg {
+                Ok(d) => d,
+                Err(reason) => {
+                    let e = self.message_error(reason);
+                    return self.fail(e, batch);
+                }
+            };
+            let (Some(d), Some(c)) = (self.decoder.as_mut(), self.chosen.as_ref()) else {
+                continue;
+            };
+            let decoded = d.decode(&data, c.serialization, &mut batch);
+            if self.info.width.is_none() {
+                self.info.width = d.width;
+                self.info.height = d.height;
+            }
+            d.describe(&mut self.info.within);
+            if let Err(reason) = decoded {
+                let e = self.message_error(reason);
+                return self.fail(e, batch);
+            }
+        }
+        Ok((!batch.is_empty()).then_some(batch))
+    }
+
+    fn message_error(&self, reason: String) -> EventError {
+        EventError::Damaged {
+            path: self.path.clone(),
+            format: self.format,
+            reason: format!("message {} of the topic: {reason}", self.messages),
+        }
+    }
+
+    fn fail(&mut self, e: EventError, batch: EventBatch) -> Result<Option<EventBatch>> {
+        self.done = true;
+        if batch.is_empty() {
+            return Err(e);
+        }
+        self.failed = Some(e);
+        Ok(Some(batch))
+    }
+}
+
+impl EventReader for Rosbag2Reader {
+    fn info(&self) -> &StreamInfo {
+        &self.info
+    }
+
+    fn next_batch(&mut self) -> Result<Option<EventBatch>> {
+        if let Some(b) = self.pending.take() {
+            return Ok(Some(b));
+        }
+        if let Some(e) = self.failed.take() {
+            return Err(e);
+        }
+        self.read_batch()
+    }
+
+    fn skipped(&self) -> Vec<(&'static str, u64)> {
+        self.decoder
+            .as_ref()
+            .map(MessageDecoder::skipped)
+            .unwrap_or_default()
+    }
+}
+
+/// What the thread reading a storage file hands on: a message's topic and its bytes
+/// (expanded, or why they could not be), `None` at the end of the file, or the damage that
+/// ended it.
+type Fed = Result<Option<(Topic, std::result::Result<Vec<u8>, String>)>>;
+
+/// Messages in flight between the thread reading a file and the decoder.
+const IN_FLIGHT: usize = 16;
+
+/// Reads `storage` (the file `file`) on a thread of its own, so that SQLite's or MCAP's work
+/// (pages, chunks, zstd) runs beside the decoding of the messages: the messages of the topic
+/// named in `chosen`, or of every topic until one is chosen.
+fn feed(storage: Storage, file: PathBuf, chosen: Arc<OnceLock<String>>) -> Receiver<Fed> {
+    let (tx, rx) = sync_channel(IN_FLIGHT);
+    std::thread::spawn(move || {
+        let mut storage = storage;
+        loop {
+            let item = match &mut storage {
+                Storage::Sqlite(s) => s.next_of(chosen.get(), &file),
+                Storage::Mcap(m) => m.next_of(chosen.get(), &file),
+            };
+            let item = item.map(|m| m.map(|(t, data)| (t, expand_message(data))));
+            let end = !matches!(item, Ok(Some(_)));
+            // a send fails once the reader is dropped: nothing is left to read for
+            if tx.send(item).is_err() || end {
+                break;
+            }
+        }
+    });
+    rx
+}
+
+/// A message compressed on its own (rosbag2's message compression mode), expanded.
+fn expand_message(msg: Vec<u8>) -> std::result::Result<Vec<u8>, String> {
+    if !msg.starts_with(ZSTD_MAGIC) {
+        return Ok(msg);
+    }
+    let mut out = Vec::new();
+    zstd::stream::read::Decoder::new(&msg[..])
+        .and_then(|d| d.take(MAX_MESSAGE as u64 + 1).read_to_end(&mut out))
+        .map_err(|e| format!("a compressed message that does not expand: {e}"))?;
+    if out.len() > MAX_MESSAGE {
+        return Err("a compressed message that expands past 1 GiB".into());
+    }
+    Ok(out)
+}
+
+fn sqlite_damage(file: &Path, e: rusqlite::Error) -> EventError {
+    EventError::Damaged {
+        path: file.to_path_buf(),
+        format: SQLITE,
+        reason: e.to_string(),
+    }
+}
+
+/// A path written into an SQLite URI (`?`, `#` and `%` escaped).
+fn percent_path(p: &Path) -> String {
+    let mut out = String::new();
+    for b in p.as_os_str().as_encoded_bytes() {
+        match b {
+            b'?' | b'#' | b'%' => out.push_str(&format!("%{b:02X}")),
+            _ if b.is_ascii() => out.push(*b as char),
+            _ => out.push_str(&format!("%{b:02X}")),
+        }
+    }
+    out
+}
+
+fn read_full(src: &mut dyn Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match src.read(&mut buf[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(n)
+}
+
+impl SqliteFile {
+    fn topics(&self) -> rusqlite::Result<Vec<Topic>> {
+        let mut counts: HashMap<i64, u64> = HashMap::new();
+        let mut q = self
+            .db
+            .prepare("SELECT topic_id, count(*) FROM messages GROUP BY topic_id")?;
+        for row in q.query_map([], |r| Ok((r.get::<_, i64>(0)?, r.get::<_, i64>(1)?)))? {
+            let (id, n) = row?;
+            counts.insert(id, n.max(0) as u64);
+        }
+        let mut q = self
+            .db
+            .prepare("SELECT id, name, type, serialization_format FROM topics ORDER BY id")?;
+        let topics = q
+            .query_map([], |r| {
+                let id: i64 = r.get(0)?;
+                Ok(Topic {
+                    id,
+                    name: r.get(1)?,
+                    msg_type: r.get(2)?,
+                    serialization: r.get(3)?,
+                    count: Some(counts.get(&id).copied().unwrap_or(0)),
+                })
+            })?
+            .collect();
+        topics
+    }
+
+    /// The next message of the topic named `chosen` (resolved on the first call).
+    fn next_of(
+        &mut self,
+        chosen: Option<&String>,
+        file: &Path,
+    ) -> Result<Option<(Topic, Vec<u8>)>> {
+        if self.topic.is_none() && !self.ended {
+            let topic = self
+                .topics()
+                .map_err(|e| sqlite_damage(file, e))?
+                .into_iter()
+                .find(|t| Some(&t.name) == chosen);
+            self.topic = topic.as_ref().map(|t| t.id);
+            self.entry = topic;
+            self.ended = self.topic.is_none();
+        }
+        let Some(entry) = &self.entry else {
+            return Ok(None);
+        };
+        let entry = entry.clone();
+        Ok(self
+            .next()
+            .map_err(|e| sqlite_damage(file, e))?
+            .map(|m| (entry, m)))
+    }
+
+    /// The next message of the topic, in the order they were written.
+    fn next(&mut self) -> rusqlite::Result<Option<Vec<u8>>> {
+        if self.page.is_empty() && !self.ended {
+            let Some(topic) = self.topic else {
+                return Ok(None);
+            };
+            let mut q = self.db.prepare_cached(
+                "SELECT id, data FROM messages WHERE topic_id = ?1 AND id > ?2 ORDER BY id LIMIT ?3",
+            )?;
+            let rows = q.query_map(rusqlite::params![topic, self.last_id, PAGE as i64], |r| {
+                Ok((r.get::<_, i64>(0)?, r.get::<_, Vec<u8>>(1)?))
+            })?;
+            for row in rows {
+                let (id, data) = row?;
+                self.last_id = id;
+                self.page.push_back(data);
+            }
+            self.ended = self.page.len() < PAGE;
+        }
+        Ok(self.page.pop_front())
+    }
+}
+
+impl McapFile {
+    /// Reads the summary at the end of the file, when it has one: its channels and counts.
+    fn read_summary(&mut self) {
+        let Ok(len) = self.src.seek(SeekFrom::End(0)) else {
+            return;
+        };
+        let mut s = SummaryReader::new_with_options(
+            SummaryReaderOptions::default()
+                .with_file_size(len)
+                .with_record_length_limit(MAX_MESSAGE),
+        );
+        let mut ok = true;
+        while let Some(event) = s.next_event() {
+            match event {
+                Ok(SummaryReadEvent::ReadRequest(n)) => match self.src.read(s.insert(n)) {
+                    Ok(k) => s.notify_read(k),
+                    Err(_) => {
+                        ok = false;
+                        break;
+                    }
+                },
+                Ok(SummaryReadEvent::SeekRequest(to)) => match self.src.seek(to) {
+                    Ok(pos) => s.notify_seeked(pos),
+                    Err(_) => {
+                        ok = false;
+                        break;
+                    }
+                },
+                Err(_) => {
+                    ok = false;
+                    break;
+                }
+            }
+        }
+        if self.src.seek(SeekFrom::Start(0)).is_err() {
+            return;
+        }
+        let summary = if ok { s.finish() } else { None };
+        let Some(summary) = summary else {
+            return;
+        };
+        let counts = summary
+            .stats
+            .as_ref()
+            .map(|s| s.channel_message_counts.clone())
+            .unwrap_or_default();
+        for (id, c) in &summary.channels {
+            self.channels.insert(
+                *id,
+                Topic {
+                    id: *id as i64,
+                    name: c.topic.clone(),
+                    msg_type: c
+                        .schema
+                        .as_ref()
+                        .map(|s| s.name.clone())
+                        .unwrap_or_default(),
+                    serialization: c.message_encoding.clone(),
+                    count: summary
+                        .stats
+                        .as_ref()
+                        .map(|_| counts.get(id).copied().unwrap_or(0)),
+                },
+            );
+        }
+    }
+
+    /// The next message of the channel of topic `chosen`, or of any channel: its topic and
+    /// bytes; `None` at the end.
+    fn next_of(
+        &mut self,
+        chosen: Option<&String>,
+        file: &Path,
+    ) -> Result<Option<(Topic, Vec<u8>)>> {
+        let damaged = |reason: String| EventError::Damaged {
+            path: file.to_path_buf(),
+            format: MCAP,
+            reason,
+        };
+        while let Some(event) = self.reader.next_event() {
+            match event.map_err(|e| damaged(e.to_string()))? {
+                LinearReadEvent::ReadRequest(n) => {
+                    let k = self
+                        .src
+                        .read(self.reader.insert(n))
+                        .map_err(|e| io_err(file, e))?;
+                    self.reader.notify_read(k);
+                }
+                LinearReadEvent::Record { data, opcode } => {
+                    match mcap::parse_record(opcode, data).map_err(|e| damaged(e.to_string()))? {
+                        mcap::records::Record::Schema { header, .. } => {
+                            self.schemas.insert(header.id, header.name);
+                        }
+                        mcap::records::Record::Channel(c) => {
+                            let msg_type =
+                                self.schemas.get(&c.schema_id).cloned().unwrap_or_default();
+                            self.channels.entry(c.id).or_insert(Topic {
+                                id: c.id as i64,
+                                name: c.topic,
+                                msg_type,
+                                serialization: c.message_encoding,
+                                count: None,
+                            });
+                        }
+                        mcap::records::Record::Message { header, data } => {
+                            let Some(t) = self.channels.get(&header.channel_id) else {
+                                continue;
+                            };
+                            if chosen.is_none_or(|c| c == &t.name) {
+                                return Ok(Some((t.clone(), data.into_owned())));
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+        Ok(None)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A ROS 2 `event_array_msgs/EventArray` in CDR of `mono` events `(t ns, x, y, p)`.
+    fn mono_packet(time_base: u64, events: &[(u32, u16, u16, bool)]) -> Vec<u8> {
+        let mut m = vec![0, 1, 0, 0];
+        m.extend([0u8; 8]); // stamp
+        m.extend(1u32.to_le_bytes()); // frame_id ""
+        m.extend([0u8, 0, 0, 0]); // its NUL, padded to 4
+        m.extend(480u32.to_le_bytes());
+        m.extend(640u32.to_le_bytes());
+        m.extend(7u64.to_le_bytes()); // seq
+        m.extend(time_base.to_le_bytes());
+        m.extend(5u32.to_le_bytes());
+        m.extend(b"mono\0");
+        m.push(0); // is_bigendian
+        m.extend([0u8; 2]); // pad to 4
+        m.extend(((events.len() * 8) as u32).to_le_bytes());
+        for &(t, x, y, p) in events {
+            let w = ((p as u64) << 63) | ((y as u64) << 48) | ((x as u64) << 32) | t as u64;
+            m.extend(w.to_le_bytes());
+        }
+        m
+    }
+
+    /// A rosbag2 SQLite file at `path`: an IMU topic, then events in two messages.
+    fn write_db3(path: &Path, compress: bool) {
+        let db = rusqlite::Connection::open(path).unwrap();
+        db.execute_batch(
+            "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL);
+             CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, data BLOB NOT NULL);
+             INSERT INTO topics VALUES (1, '/imu', 'sensor_msgs/msg/Imu', 'cdr', '');
+             INSERT INTO topics VALUES (2, '/events', 'event_array_msgs/msg/EventArray', 'cdr', '');",
+        )
+        .unwrap();
+        let msgs = [
+            (1, vec![0u8, 1, 0, 0, 9]),
+            (
+                2,
+                mono_packet(1_000_000, &[(1000, 1, 2, true), (3000, 3, 4, false)]),
+            ),
+            (1, vec![0u8, 1, 0, 0, 9]),
+            (2, mono_packet(2_000_000, &[(0, 5, 6, true)])),
+        ];
+        for (i, (topic, data)) in msgs.into_iter().enumerate() {
+            let data = if compress {
+                zstd::encode_all(&data[..], 1).unwrap()
+            } else {
+                data
+            };
+            db.execute(
+                "INSERT INTO messages VALUES (?1, ?2, ?3, ?4)",
+                rusqlite::params![i as i64 + 1, topic, i as i64, data],
+            )
+            .unwrap();
+        }
+    }
+
+    fn read(path: &Path, topic: Option<&str>) -> Result<(StreamInfo, EventBatch)> {
+        let mut r = crate::open_with(
+            path,
+            &crate::OpenOptions {
+                topic: topic.map(str::to_string),
+                ..Default::default()
+            },
+        )?;
+        let mut all = EventBatch::default();
+        while let Some(b) = r.next_batch()? {
+            all.extend_from(&b);
+        }
+        Ok((r.info().clone(), all))
+    }
+
+    #[test]
+    fn sqlite_folders_and_files_compressed_or_not() {
+        let dir = tempfile::tempdir().unwrap();
+        for compress in [false, true] {
+            let bag = dir.path().join(format!("bag{compress}"));
+            std::fs::create_dir(&bag).unwrap();
+            write_db3(&bag.join("bag_0.db3"), compress);
+            for path in [bag.clone(), bag.join("bag_0.db3")] {
+                let (info, b) = read(&path, None).unwrap();
+                assert_eq!(info.format, "rosbag2 (SQLite)");
+                assert_eq!(b.t, vec![1_001, 1_003, 2_000]);
+                assert_eq!((b.x, b.y), (vec![1, 3, 5], vec![2, 4, 6]));
+                assert_eq!(b.p, vec![true, false, true]);
+                assert_eq!((info.width, info.height), (Some(640), Some(480)));
+                let counts: Vec<_> = info.streams.iter().map(|s| s.messages).collect();
+                assert_eq!(counts, vec![Some(2), Some(2)]);
+            }
+        }
+        // a split bag: its files in the order metadata.yaml lists them
+        let split = dir.path().join("split");
+        std::fs::create_dir(&split).unwrap();
+        write_db3(&split.join("b_1.db3"), false);
+        write_db3(&split.join("b_0.db3"), true);
+        std::fs::write(
+            split.join("metadata.yaml"),
+            "rosbag2_bagfile_information:\n  relative_file_paths:\n    - b_0.db3\n    - b_1.db3\n  files: []\n",
+        )
+        .unwrap();
+        assert_eq!(read(&split, None).unwrap().1.len(), 6);
+        // topics asked for by name; ones that are not there or carry no events are refused
+        let bag = dir.path().join("bagfalse");
+        let e = read(&bag, Some("/imu")).unwrap_err().to_string();
+        assert!(e.contains("sensor_msgs/msg/Imu"), "{e}");
+        let e = read(&bag, Some("/nope")).unwrap_err().to_string();
+        assert!(
+            e.contains("/events (event_array_msgs/msg/EventArray)"),
+            "{e}"
+        );
+        // a folder that is no bag, and an SQLite database that is no bag
+        let e = read(dir.path(), None).unwrap_err().to_string();
+        assert!(e.contains("not a rosbag2"), "{e}");
+        let other = dir.path().join("other.db3");
+        rusqlite::Connection::open(&other)
+            .unwrap()
+            .execute_batch("CREATE TABLE t(a)")
+            .unwrap();
+        let e = read(&other, None).unwrap_err().to_string();
+        assert!(e.contains("without the tables of a rosbag2"), "{e}");
+    }
+
+    fn write_mcap(summary: bool) -> Vec<u8> {
+        let mut out = std::io::Cursor::new(Vec::new());
+        let opts = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .use_chunks(true)
+            .emit_summary_records(summary)
+            .emit_summary_offsets(summary)
+            .emit_statistics(summary)
+            .emit_chunk_indexes(summary)
+            .emit_message_indexes(summary);
+        let mut w = opts.create(&mut out).unwrap();
+        let imu = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
+        let ev = w
+            .add_schema("event_array_msgs/msg/EventArray", "ros2msg", b"")
+            .unwrap();
+        let imu = w
+            .add_channel(imu, "/imu", "cdr", &Default::default())
+            .unwrap();
+        let ev = w
+            .add_channel(ev, "/events", "cdr", &Default::default())
+            .unwrap();
+        for (i, (ch, data)) in [
+            (imu, vec![0u8, 1, 0, 0]),
+            (ev, mono_packet(0, &[(5000, 1, 1, true)])),
+            (ev, mono_packet(0, &[(9000, 2, 2, false)])),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let header = mcap::records::MessageHeader {
+                channel_id: ch,
+                sequence: i as u32,
+                log_time: i as u64,
+                publish_time: i as u64,
+            };
+            w.write_to_known_channel(&header, &data).unwrap();
+        }
+        w.finish().unwrap();
+        drop(w);
+        out.into_inner()
+    }
+
+    #[test]
+    fn mcap_with_and_without_its_summary() {
+        for summary in [true, false] {
+            let bytes = write_mcap(summary);
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("b.mcap");
+            std::fs::write(&path, &bytes).unwrap();
+            let (info, b) = read(&path, None).unwrap();
+            assert_eq!(info.format, "rosbag2 (MCAP)");
+            assert_eq!(b.t, vec![5, 9]);
+            let counts: Vec<_> = info.streams.iter().map(|s| s.messages).collect();
+            let want = if summary {
+                vec![Some(1), Some(2)]
+            } else {
+                vec![None, None]
+            };
+            assert_eq!(counts, want, "summary {summary}");
+            // cut anywhere: an error or the events before the cut, never a panic
+            for cut in 0..bytes.len() {
+                std::fs::write(&path, &bytes[..cut]).unwrap();
+                if let Ok(mut r) = crate::open(&path) {
+                    let mut n = 0;
+                    while let Ok(Some(b)) = r.next_batch() {
+                        n += b.len();
+                    }
+                    assert!(n <= 2);
+                }
+            }
+        }
+    }
+}
