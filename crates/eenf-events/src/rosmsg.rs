@@ -1,5 +1,5 @@
 //! The event messages of ROS 1 and ROS 2, decoded into [`EventBatch`]es: what a bag holds,
-//! whichever bag it is (ROS 1 [`crate::rosbag`], rosbag2 [`crate::rosbag2`]).
+//! whichever bag it is (ROS 1 or rosbag2).
 //!
 //! Messages:
 //! - `dvs_msgs/EventArray` and `prophesee_event_msgs/EventArray`: a header, `u32` height and
