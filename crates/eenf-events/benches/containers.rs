@@ -4,6 +4,9 @@
 //!
 //! The files are written once into the target folder (`EENF_BENCH_SECONDS`, default 10 s =
 //! 20 M events); `cargo bench -p eenf-events --bench containers` prints events/s.
+//!
+//! `dsec`: a DSEC-layout HDF5 file (blosc + zstd), when `tools/hdf5_bench.py write` has made
+//! one (`target/tmp/dsec-bench.h5`); `tools/hdf5_bench.py peer` times h5py on the same file.
 #![allow(missing_docs)] // criterion_group! makes undocumented public functions
 
 use std::path::{Path, PathBuf};
@@ -167,6 +170,29 @@ fn benches(c: &mut Criterion) {
             })
         });
     }
+    g.finish();
+    let dsec = dir.join("dsec-bench.h5");
+    if !dsec.exists() {
+        eprintln!(
+            "dsec: skipped ({} missing: run tools/hdf5_bench.py write)",
+            dsec.display()
+        );
+        return;
+    }
+    let n = eenf_events::open(&dsec).unwrap().info().event_count.unwrap();
+    let mut g = c.benchmark_group("dsec");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(n));
+    g.bench_function("hdf5_blosc_zstd", |b| {
+        b.iter(|| {
+            let mut r = eenf_events::open(&dsec).unwrap();
+            let mut count = 0u64;
+            while let Some(batch) = r.next_batch().unwrap() {
+                count += batch.len() as u64;
+            }
+            assert_eq!(count, n);
+        })
+    });
     g.finish();
 }
 

@@ -406,13 +406,13 @@ impl BagReader {
                             self.decoder
                                 .decode(&rec.data, Serialization::Ros1, &mut batch);
                         self.note_size();
-                        if let Err(reason) = decoded {
-                            let e = EventError::Corrupt {
+                        if let Err(fault) = decoded {
+                            let e = fault.into_error(&self.path, |reason| EventError::Corrupt {
                                 path: self.path.clone(),
                                 format: FORMAT,
                                 offset: at,
                                 reason,
-                            };
+                            });
                             return self.fail(e, batch);
                         }
                     }

@@ -543,8 +543,8 @@ impl Rosbag2Reader {
                 self.info.height = d.height;
             }
             d.describe(&mut self.info.within);
-            if let Err(reason) = decoded {
-                let e = self.message_error(reason);
+            if let Err(fault) = decoded {
+                let e = fault.into_error(&self.path, |reason| self.message_error(reason));
                 return self.fail(e, batch);
             }
         }

@@ -60,6 +60,45 @@ pub(crate) enum Serialization {
 
 type Res<T> = std::result::Result<T, String>;
 
+/// Why a message could not be decoded.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum Fault {
+    /// Its bytes are damaged or cut short.
+    Damaged(String),
+    /// It is sound but in a form eenf does not read (an encoding, a byte order).
+    Unsupported(String),
+}
+
+impl From<String> for Fault {
+    fn from(s: String) -> Self {
+        Fault::Damaged(s)
+    }
+}
+
+impl From<&str> for Fault {
+    fn from(s: &str) -> Self {
+        Fault::Damaged(s.to_string())
+    }
+}
+
+impl Fault {
+    /// The error a reader reports for it: `damaged` for damage, else that the file does not
+    /// fit what eenf reads.
+    pub fn into_error(
+        self,
+        path: &std::path::Path,
+        damaged: impl FnOnce(String) -> crate::EventError,
+    ) -> crate::EventError {
+        match self {
+            Fault::Damaged(reason) => damaged(reason),
+            Fault::Unsupported(reason) => crate::EventError::Unfit {
+                path: path.to_path_buf(),
+                reason,
+            },
+        }
+    }
+}
+
 /// A cursor over one message's bytes.
 struct Cursor<'a> {
     b: &'a [u8],
@@ -217,7 +256,12 @@ impl MessageDecoder {
     }
 
     /// Decodes one message into `out`.
-    pub fn decode(&mut self, data: &[u8], ser: Serialization, out: &mut EventBatch) -> Res<()> {
+    pub fn decode(
+        &mut self,
+        data: &[u8],
+        ser: Serialization,
+        out: &mut EventBatch,
+    ) -> std::result::Result<(), Fault> {
         let mut m = Cursor::new(data, ser)?;
         m.header()?;
         let height = m.u32()?;
@@ -245,10 +289,10 @@ impl MessageDecoder {
                 } else {
                     // CDR: each field aligned; at least 13 bytes an event bounds the count
                     if n > data.len() / 13 {
-                        return Err(format!(
+                        return Err(Fault::Damaged(format!(
                             "{n} events announced in a {} byte message",
                             data.len()
-                        ));
+                        )));
                     }
                     for _ in 0..n {
                         let x = m.u16()?;
@@ -272,7 +316,9 @@ impl MessageDecoder {
                     self.encoding = Some(String::from_utf8_lossy(encoding).into_owned());
                 }
                 if big_endian {
-                    return Err("big-endian event packets, which eenf does not read".into());
+                    return Err(Fault::Unsupported(
+                        "big-endian event packets, which eenf does not read".into(),
+                    ));
                 }
                 match encoding {
                     b"evt3" => self.evt3.decode(&bytes[..bytes.len() / 2 * 2], out)?,
@@ -280,10 +326,10 @@ impl MessageDecoder {
                     b"libcaer_cmp" => self.cmp.decode(bytes, time_base, width, height, out),
                     b"mono" => mono(bytes, time_base, out),
                     other => {
-                        return Err(format!(
+                        return Err(Fault::Unsupported(format!(
                             "packets in the {:?} encoding, which eenf does not read (it reads evt3, libcaer, libcaer_cmp, mono)",
                             String::from_utf8_lossy(other)
-                        ))
+                        )))
                     }
                 }
             }

@@ -82,12 +82,18 @@ mod blosc {
 
     /// `data` expanded into `n` bytes (as validated by [`expanded_size`]).
     pub fn decompress(data: &[u8], n: usize) -> Option<Vec<u8>> {
-        let mut out = vec![0u8; n];
-        // SAFETY: the header was validated against `data.len()`; `out` is writable for `n`
+        // not zeroed first: c-blosc writes every byte of a chunk it expands whole
+        let mut out: Vec<u8> = Vec::with_capacity(n);
+        // SAFETY: the header was validated against `data.len()`; `out` has room for `n`
         // bytes, the size passed; one internal thread, no global state.
         let rc = unsafe {
             blosc_src::blosc_decompress_ctx(data.as_ptr().cast(), out.as_mut_ptr().cast(), n, 1)
         };
-        (rc >= 0 && rc as usize == n).then_some(out)
+        if rc < 0 || rc as usize != n {
+            return None;
+        }
+        // SAFETY: blosc_decompress_ctx returned `n`: it wrote all `n` bytes
+        unsafe { out.set_len(n) };
+        Some(out)
     }
 }

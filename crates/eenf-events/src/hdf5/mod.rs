@@ -294,20 +294,91 @@ fn leaf(name: &str) -> &str {
 
 /// A scalar integer dataset's value.
 fn scalar_i64(d: &Dataset) -> hdf5_reader::error::Result<i64> {
-    let v = read_i64(d, &SliceInfo::all(d.ndim()))?;
-    v.first()
-        .copied()
+    read_numbers(d, &SliceInfo::all(d.ndim()))?
+        .first_i64()
         .ok_or_else(|| hdf5_reader::error::Error::InvalidData("an empty t_offset".into()))
 }
 
-/// Integers of any size and sign, or floats, of `d`'s selection, as `i64` (floats rounded).
-fn read_i64(d: &Dataset, sel: &SliceInfo) -> hdf5_reader::error::Result<Vec<i64>> {
-    macro_rules! ints {
-        ($t:ty) => {
-            d.read_slice_parallel::<$t>(sel)?
+/// The numbers of a dataset's selection, in the dataset's own type.
+enum Numbers {
+    U8(Vec<u8>),
+    I8(Vec<i8>),
+    U16(Vec<u16>),
+    I16(Vec<i16>),
+    U32(Vec<u32>),
+    I32(Vec<i32>),
+    U64(Vec<u64>),
+    I64(Vec<i64>),
+    F32(Vec<f32>),
+    F64(Vec<f64>),
+}
+
+/// Applies `$f` to the vector inside a [`Numbers`], whatever its type.
+macro_rules! each {
+    ($n:expr, $v:ident => $f:expr) => {
+        match $n {
+            Numbers::U8($v) => $f,
+            Numbers::I8($v) => $f,
+            Numbers::U16($v) => $f,
+            Numbers::I16($v) => $f,
+            Numbers::U32($v) => $f,
+            Numbers::I32($v) => $f,
+            Numbers::U64($v) => $f,
+            Numbers::I64($v) => $f,
+            Numbers::F32($v) => $f,
+            Numbers::F64($v) => $f,
+        }
+    };
+}
+
+// `each!` writes one cast for every type, the type itself among them
+#[allow(clippy::unnecessary_cast)]
+impl Numbers {
+    /// As coordinates: a `u16` column is handed on as it is, others are clamped.
+    fn into_u16(self) -> Vec<u16> {
+        match self {
+            Numbers::U16(v) => v,
+            n => {
+                each!(n, v => v.iter().map(|&x| (x as f64).clamp(0.0, u16::MAX as f64) as u16).collect())
+            }
+        }
+    }
+
+    /// As times, µs, plus `offset` (floats are rounded).
+    fn into_i64(self, offset: i64) -> Vec<i64> {
+        match self {
+            Numbers::I64(mut v) if offset == 0 => {
+                v.shrink_to_fit();
+                v
+            }
+            Numbers::F32(v) => v
                 .iter()
-                .map(|&v| v as i64)
-                .collect()
+                .map(|&x| (x as f64).round() as i64 + offset)
+                .collect(),
+            Numbers::F64(v) => v.iter().map(|&x| x.round() as i64 + offset).collect(),
+            n => each!(n, v => v.iter().map(|&x| (x as i64).saturating_add(offset)).collect()),
+        }
+    }
+
+    /// As polarities: ON when positive.
+    fn into_bool(self) -> Vec<bool> {
+        each!(self, v => v.iter().map(|&x| x as f64 > 0.0).collect())
+    }
+
+    fn first_i64(&self) -> Option<i64> {
+        each!(self, v => v.first().map(|&x| x as i64))
+    }
+}
+
+/// The numbers of `d`'s selection, its chunks decoded on all cores.
+fn read_numbers(d: &Dataset, sel: &SliceInfo) -> hdf5_reader::error::Result<Numbers> {
+    macro_rules! read {
+        ($t:ty, $k:ident) => {
+            Numbers::$k(
+                d.read_slice_parallel::<$t>(sel)?
+                    .into_raw_vec_and_offset()
+                    .0,
+            )
         };
     }
     Ok(match d.dtype() {
@@ -315,52 +386,44 @@ fn read_i64(d: &Dataset, sel: &SliceInfo) -> hdf5_reader::error::Result<Vec<i64>
             size: 1,
             signed: false,
             ..
-        } => ints!(u8),
+        } => read!(u8, U8),
         Datatype::FixedPoint {
             size: 1,
             signed: true,
             ..
-        } => ints!(i8),
+        } => read!(i8, I8),
         Datatype::FixedPoint {
             size: 2,
             signed: false,
             ..
-        } => ints!(u16),
+        } => read!(u16, U16),
         Datatype::FixedPoint {
             size: 2,
             signed: true,
             ..
-        } => ints!(i16),
+        } => read!(i16, I16),
         Datatype::FixedPoint {
             size: 4,
             signed: false,
             ..
-        } => ints!(u32),
+        } => read!(u32, U32),
         Datatype::FixedPoint {
             size: 4,
             signed: true,
             ..
-        } => ints!(i32),
+        } => read!(i32, I32),
         Datatype::FixedPoint {
             size: 8,
             signed: false,
             ..
-        } => ints!(u64),
+        } => read!(u64, U64),
         Datatype::FixedPoint {
             size: 8,
             signed: true,
             ..
-        } => ints!(i64),
-        Datatype::FloatingPoint { size: 4, .. } => d
-            .read_slice_parallel::<f32>(sel)?
-            .iter()
-            .map(|&v| v.round() as i64)
-            .collect(),
-        Datatype::FloatingPoint { size: 8, .. } => d
-            .read_slice_parallel::<f64>(sel)?
-            .iter()
-            .map(|&v| v.round() as i64)
-            .collect(),
+        } => read!(i64, I64),
+        Datatype::FloatingPoint { size: 4, .. } => read!(f32, F32),
+        Datatype::FloatingPoint { size: 8, .. } => read!(f64, F64),
         other => {
             return Err(hdf5_reader::error::Error::InvalidData(format!(
                 "dataset {} holds {other:?}, not numbers",
@@ -420,21 +483,18 @@ impl Hdf5Reader {
                 let sel = SliceInfo {
                     selections: vec![range(start, end)],
                 };
+                let offset = *t_offset;
+                let u16s = |d| read_numbers(d, &sel).map(Numbers::into_u16);
                 let ((xs, ys), (ps, ts)) = rayon::join(
-                    || rayon::join(|| read_i64(x, &sel), || read_i64(y, &sel)),
-                    || rayon::join(|| read_i64(p, &sel), || read_i64(t, &sel)),
+                    || rayon::join(|| u16s(x), || u16s(y)),
+                    || {
+                        rayon::join(
+                            || read_numbers(p, &sel).map(Numbers::into_bool),
+                            || read_numbers(t, &sel).map(|n| n.into_i64(offset)),
+                        )
+                    },
                 );
-                let (xs, ys, ps, ts) = (xs?, ys?, ps?, ts?);
-                b.t = ts.iter().map(|&t| t.saturating_add(*t_offset)).collect();
-                b.x = xs
-                    .iter()
-                    .map(|&v| v.clamp(0, u16::MAX as i64) as u16)
-                    .collect();
-                b.y = ys
-                    .iter()
-                    .map(|&v| v.clamp(0, u16::MAX as i64) as u16)
-                    .collect();
-                b.p = ps.iter().map(|&v| v > 0).collect();
+                (b.x, b.y, b.p, b.t) = (xs?, ys?, ps?, ts?);
                 self.pos = end;
             }
             Layout::Table { events } => {
@@ -532,5 +592,217 @@ impl EventReader for Hdf5Reader {
 
     fn batch_offset(&self) -> Option<u64> {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hdf5_writer::{
+        AttributeBuilder, ByteOrder, CompoundField, DatasetBuilder, FilterDescription, Hdf5Builder,
+        WriteOptions,
+    };
+
+    fn deflate() -> FilterDescription {
+        FilterDescription {
+            id: 1,
+            name: None,
+            client_data: vec![4],
+        }
+    }
+
+    /// `n` events: x = i % 640, y = i % 480, p = i odd, t = i / 2 µs.
+    fn events(n: usize) -> (Vec<u16>, Vec<u16>, Vec<u8>, Vec<u32>) {
+        (
+            (0..n).map(|i| (i % 640) as u16).collect(),
+            (0..n).map(|i| (i % 480) as u16).collect(),
+            (0..n).map(|i| (i % 2) as u8).collect(),
+            (0..n).map(|i| (i / 2) as u32).collect(),
+        )
+    }
+
+    fn write(b: Hdf5Builder) -> Vec<u8> {
+        b.into_plan()
+            .unwrap()
+            .encode(WriteOptions::default())
+            .unwrap()
+    }
+
+    fn read(bytes: &[u8], camera: Option<u8>) -> Result<(StreamInfo, EventBatch)> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("e.h5");
+        std::fs::write(&path, bytes).unwrap();
+        let mut r = crate::open_with(
+            &path,
+            &crate::OpenOptions {
+                camera,
+                ..Default::default()
+            },
+        )?;
+        let mut all = EventBatch::default();
+        while let Some(b) = r.next_batch()? {
+            all.extend_from(&b);
+        }
+        Ok((r.info().clone(), all))
+    }
+
+    /// The DSEC layout: one chunked, deflated dataset per field and a `t_offset`.
+    fn dsec(n: usize) -> Vec<u8> {
+        let (x, y, p, t) = events(n);
+        write(
+            Hdf5Builder::new()
+                .dataset(
+                    DatasetBuilder::typed_data("events/x", [n as u64], &x)
+                        .unwrap()
+                        .chunked([700])
+                        .filter(deflate()),
+                )
+                .dataset(
+                    DatasetBuilder::typed_data("events/y", [n as u64], &y)
+                        .unwrap()
+                        .chunked([700])
+                        .filter(deflate()),
+                )
+                .dataset(
+                    DatasetBuilder::typed_data("events/p", [n as u64], &p)
+                        .unwrap()
+                        .chunked([1400])
+                        .filter(deflate()),
+                )
+                .dataset(
+                    DatasetBuilder::typed_data("events/t", [n as u64], &t)
+                        .unwrap()
+                        .chunked([350])
+                        .filter(deflate()),
+                )
+                .dataset(
+                    DatasetBuilder::typed_data("t_offset", Vec::<u64>::new(), &[1_000i64]).unwrap(),
+                ),
+        )
+    }
+
+    #[test]
+    fn dsec_columns_with_their_time_offset() {
+        let n = 3_000;
+        let (info, b) = read(&dsec(n), None).unwrap();
+        let (x, y, p, t) = events(n);
+        assert_eq!(info.format, "HDF5");
+        assert_eq!(info.event_count, Some(n as u64));
+        assert_eq!(info.within.as_deref(), Some("group /events"));
+        assert_eq!(b.x, x);
+        assert_eq!(b.y, y);
+        assert_eq!(b.p, p.iter().map(|&v| v == 1).collect::<Vec<_>>());
+        assert_eq!(b.t, t.iter().map(|&v| v as i64 + 1_000).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn prophesee_compound_events_chunked_or_not() {
+        let n = 2_500usize;
+        let (x, y, p, t) = events(n);
+        let field = |name: &str, off: u32, size: u8, signed: bool| CompoundField {
+            name: name.into(),
+            byte_offset: off,
+            datatype: Datatype::FixedPoint {
+                size,
+                signed,
+                byte_order: ByteOrder::LittleEndian,
+            },
+        };
+        let dtype = Datatype::Compound {
+            size: 16,
+            fields: vec![
+                field("x", 0, 2, false),
+                field("y", 2, 2, false),
+                field("p", 4, 2, true),
+                field("t", 8, 8, true),
+            ],
+        };
+        let mut raw = Vec::new();
+        for i in 0..n {
+            raw.extend(x[i].to_le_bytes());
+            raw.extend(y[i].to_le_bytes());
+            raw.extend((p[i] as i16).to_le_bytes());
+            raw.extend([0, 0]);
+            raw.extend((t[i] as i64).to_le_bytes());
+        }
+        for chunked in [true, false] {
+            let mut d =
+                DatasetBuilder::new("CD/events", dtype.clone(), [n as u64]).raw_data(raw.clone());
+            if chunked {
+                d = d.chunked([1000]).filter(deflate());
+            }
+            let bytes = write(
+                Hdf5Builder::new()
+                    .dataset(d)
+                    .attribute(AttributeBuilder::fixed_string("geometry", "640x480")),
+            );
+            let (info, b) = read(&bytes, None).unwrap();
+            assert_eq!((info.width, info.height), (Some(640), Some(480)));
+            assert_eq!(info.within.as_deref(), Some("dataset /CD/events"));
+            assert_eq!(
+                (b.x.clone(), b.y.clone()),
+                (x.clone(), y.clone()),
+                "{chunked}"
+            );
+            assert_eq!(b.t, t.iter().map(|&v| v as i64).collect::<Vec<_>>());
+            assert_eq!(b.p.iter().filter(|&&p| p).count(), n / 2);
+        }
+    }
+
+    #[test]
+    fn mvsec_tables_one_camera_each() {
+        let rows = |k: f64| -> Vec<f64> {
+            (0..10)
+                .flat_map(|i| {
+                    [
+                        i as f64 + k,
+                        2.0 * i as f64,
+                        1.5 + i as f64 * 1e-3,
+                        if i % 2 == 0 { 1.0 } else { -1.0 },
+                    ]
+                })
+                .collect()
+        };
+        let bytes = write(
+            Hdf5Builder::new()
+                .dataset(
+                    DatasetBuilder::typed_data("davis/left/events", [10, 4], &rows(0.0)).unwrap(),
+                )
+                .dataset(
+                    DatasetBuilder::typed_data("davis/right/events", [10, 4], &rows(100.0))
+                        .unwrap(),
+                ),
+        );
+        let (info, b) = read(&bytes, None).unwrap();
+        assert_eq!(
+            info.cameras,
+            vec!["davis/left/events", "davis/right/events"]
+        );
+        assert_eq!(b.t[..3], [1_500_000, 1_501_000, 1_502_000]);
+        assert_eq!((b.x[1], b.y[1], b.p[0], b.p[1]), (1, 2, true, false));
+        let (_, right) = read(&bytes, Some(1)).unwrap();
+        assert_eq!(right.x[0], 100);
+        let e = read(&bytes, Some(2)).unwrap_err().to_string();
+        assert!(
+            e.contains("camera 2") && e.contains("davis/right/events"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn files_without_events_or_cut_short_get_one_line_errors() {
+        let bytes = write(
+            Hdf5Builder::new()
+                .dataset(DatasetBuilder::typed_data("a/b", [3], &[1u8, 2, 3]).unwrap()),
+        );
+        let e = read(&bytes, None).unwrap_err().to_string();
+        assert!(e.contains("without events"), "{e}");
+        let whole = dsec(3_000);
+        for cut in (0..whole.len()).step_by(97) {
+            match read(&whole[..cut], None) {
+                Ok((_, b)) => assert!(b.len() <= 3_000),
+                Err(e) => assert!(!e.to_string().contains('\n'), "{e}"),
+            }
+        }
     }
 }
