@@ -179,7 +179,11 @@ fn benches(c: &mut Criterion) {
         );
         return;
     }
-    let n = eenf_events::open(&dsec).unwrap().info().event_count.unwrap();
+    let n = eenf_events::open(&dsec)
+        .unwrap()
+        .info()
+        .event_count
+        .unwrap();
     let mut g = c.benchmark_group("dsec");
     g.sample_size(10);
     g.throughput(Throughput::Elements(n));

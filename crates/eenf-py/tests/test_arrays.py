@@ -164,3 +164,21 @@ def test_expelliarmus_evt2_fixtures_read_the_same(shared):
         assert len(ours) == len(theirs), f
         for a in "txyp":
             assert np.array_equal(ours[a].astype(np.int64), theirs[a].astype(np.int64)), (f, a)
+
+
+def test_bags_and_hdf5_give_the_recordings_events(shared):
+    """The real Prophesee bag as ROS 1, as rosbag2 (its folder) and in Prophesee's ECF HDF5:
+    the same 343,474 events; the DSEC layout's first 38,478 with its time offset."""
+    c = shared / "fixtures" / "containers"
+    bag = eenf.read_events(c / "ros1" / "event_camera_py_test_events_1.bag")
+    assert len(bag) == 343_474
+    folder = eenf.read_events(c / "ros2" / "event_camera_py_test_events_1")
+    assert np.array_equal(folder, bag)
+    order = ["t", "x", "y", "p"]
+    ecf = eenf.read_events(c / "hdf5" / "prophesee_ecf_layout.hdf5")
+    assert np.array_equal(np.sort(ecf, order=order), np.sort(bag, order=order))
+    dsec = eenf.read_events(c / "hdf5" / "dsec_layout_blosc_zstd.h5")
+    first = np.sort(bag, order=order)[:38_478]
+    assert np.array_equal(np.sort(dsec, order=order), first)
+    with pytest.raises(ValueError, match="no topic"):
+        eenf.read_events(c / "ros2" / "codecs_mono_cd", topic="/nope")
