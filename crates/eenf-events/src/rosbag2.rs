@@ -977,7 +977,11 @@ mod tests {
         let zbag = dir.path().join("zstd");
         std::fs::create_dir(&zbag).unwrap();
         let db = std::fs::read(split.join("b_1.db3")).unwrap();
-        std::fs::write(zbag.join("b_0.db3.zstd"), zstd::encode_all(&db[..], 3).unwrap()).unwrap();
+        std::fs::write(
+            zbag.join("b_0.db3.zstd"),
+            zstd::encode_all(&db[..], 3).unwrap(),
+        )
+        .unwrap();
         assert_eq!(read(&zbag, None).unwrap().1.t, vec![1_001, 1_003, 2_000]);
         // topics asked for by name; ones that are not there or carry no events are refused
         let bag = dir.path().join("bagfalse");
