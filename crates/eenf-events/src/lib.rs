@@ -467,11 +467,11 @@ fn finish(
         opts.strict,
         opts.max_gap_us.unwrap_or(DEFAULT_MAX_GAP_US),
     );
-    // AEDAT4 packets are decoded on both cores: reading ahead on a thread of its own lets the
-    // consumer's work overlap with them (about 5 % off a 60 s LZ4 extraction); the word
-    // formats decode on one core in small batches, where handing batches across threads
-    // cost more than it saved (7–20 % slower), so they are read in line
-    if format == Format::Aedat4 {
+    // AEDAT4 packets and HDF5 slices are decoded on both cores: reading ahead on a thread of
+    // its own lets the consumer's work overlap with them (about 5 % off a 60 s LZ4
+    // extraction); the word formats decode on one core in small batches, where handing
+    // batches across threads cost more than it saved (7–20 % slower), so they are read in line
+    if matches!(format, Format::Aedat4 | Format::Hdf5) {
         return prefetch::read_ahead(Box::new(guarded), path);
     }
     Ok(Box::new(guarded))
