@@ -28,6 +28,7 @@ mod error;
 pub mod eventstream;
 mod guard;
 pub mod hdf5;
+mod held;
 pub mod jaer;
 pub mod memory;
 mod prefetch;

@@ -15,6 +15,7 @@ use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use crate::error::{io_err, EventError, Result};
+use crate::held::Held;
 use crate::rosmsg::{kind_of, MessageDecoder, Serialization};
 use crate::{EventBatch, EventReader, Source, StreamDesc, StreamInfo};
 
@@ -184,8 +185,7 @@ pub struct BagReader {
     decoder: MessageDecoder,
     info: StreamInfo,
     /// The first batch, read on opening (the sensor's size is in the messages).
-    pending: Option<EventBatch>,
-    failed: Option<EventError>,
+    held: Held,
     done: bool,
 }
 
@@ -314,15 +314,12 @@ pub fn reader(
         conns,
         decoder: MessageDecoder::new(kind),
         info,
-        pending: None,
-        failed: None,
+        held: Held::default(),
         done: false,
     };
     // the sensor's size comes with the first message: read it now, hand it out first
-    match bag.read_batch() {
-        Ok(b) => bag.pending = b,
-        Err(e) => bag.failed = Some(e),
-    }
+    let first = bag.read_batch();
+    bag.held.hold(first);
     Ok(Box::new(bag))
 }
 
@@ -340,11 +337,7 @@ fn connection(rec: &Record) -> Option<(u32, Topic)> {
 impl BagReader {
     fn fail(&mut self, e: EventError, batch: EventBatch) -> Result<Option<EventBatch>> {
         self.done = true;
-        if batch.is_empty() {
-            return Err(e);
-        }
-        self.failed = Some(e);
-        Ok(Some(batch))
+        self.held.fail(e, batch)
     }
 }
 
@@ -365,13 +358,10 @@ impl EventReader for BagReader {
     }
 
     fn next_batch(&mut self) -> Result<Option<EventBatch>> {
-        if let Some(b) = self.pending.take() {
-            return Ok(Some(b));
+        match self.held.take() {
+            Some(held) => held,
+            None => self.read_batch(),
         }
-        if let Some(e) = self.failed.take() {
-            return Err(e);
-        }
-        self.read_batch()
     }
 
     fn batch_offset(&self) -> Option<u64> {

@@ -22,6 +22,7 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::sans_io::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
 
 use crate::error::{io_err, EventError, Result};
+use crate::held::Held;
 use crate::rosmsg::{kind_of, MessageDecoder, Serialization, TYPES};
 use crate::{EventBatch, EventReader, Source, StreamDesc, StreamInfo};
 
@@ -36,7 +37,7 @@ const MCAP: &str = "rosbag2 (MCAP)";
 /// The largest message (or MCAP record) accepted, expanded.
 pub const MAX_MESSAGE: usize = 1 << 30;
 /// Messages fetched from SQLite at a time.
-const PAGE: usize = 64;
+const PAGE: usize = 256;
 
 /// True when `dir` looks like a rosbag2 folder: it holds a storage file or `metadata.yaml`.
 pub fn is_folder(dir: &Path) -> bool {
@@ -159,7 +160,9 @@ pub struct Rosbag2Reader {
     next_file: usize,
     storage: Option<Storage>,
     /// The storage file being read, on a thread of its own.
-    feed: Option<Receiver<Fed>>,
+    feed: Option<Receiver<Vec<Fed>>>,
+    /// What the thread handed on and the decoder has yet to take.
+    fed: std::vec::IntoIter<Fed>,
     format: &'static str,
     /// The topic asked for, then the topic read.
     wanted: Option<String>,
@@ -170,8 +173,7 @@ pub struct Rosbag2Reader {
     seen: Vec<Topic>,
     decoder: Option<MessageDecoder>,
     info: StreamInfo,
-    pending: Option<EventBatch>,
-    failed: Option<EventError>,
+    held: Held,
     done: bool,
     messages: u64,
     /// The topics of the first file, kept when it ends (an MCAP without a summary names them
@@ -214,6 +216,7 @@ fn start(
         next_file: 0,
         storage: None,
         feed: None,
+        fed: Vec::new().into_iter(),
         format: SQLITE,
         wanted: topic.map(str::to_string),
         chosen: None,
@@ -221,8 +224,7 @@ fn start(
         seen: Vec::new(),
         decoder: None,
         info: StreamInfo::default(),
-        pending: None,
-        failed: None,
+        held: Held::default(),
         done: false,
         messages: 0,
         first_topics: Vec::new(),
@@ -234,17 +236,15 @@ fn start(
         r.choose(&topics)?;
     }
     // the sensor's size comes with the first message: read it now, hand it out first
-    match r.read_batch() {
-        Ok(b) => r.pending = b,
-        Err(e) => r.failed = Some(e),
-    }
+    let first = r.read_batch();
+    r.held.hold(first);
     // an MCAP without a summary: the channels seen so far
     let topics = match (topics.is_empty(), r.first_topics.is_empty()) {
         (false, _) => topics,
         (true, true) => r.topics(),
         (true, false) => r.first_topics.clone(),
     };
-    if r.chosen.is_none() && r.failed.is_none() {
+    if r.chosen.is_none() && !r.held.failed() {
         return Err(r.no_topic(&topics));
     }
     r.info.streams = topics
@@ -476,10 +476,16 @@ impl Rosbag2Reader {
                 };
                 self.feed = Some(feed(storage, file, self.chosen_name.clone()));
             }
-            let got = match self.feed.as_ref().map(|rx| rx.recv()) {
-                Some(Ok(got)) => got,
-                // the thread ended without a word: taken as the end of the file
-                _ => Ok(None),
+            let got = match self.fed.next() {
+                Some(got) => got,
+                None => match self.feed.as_ref().map(|rx| rx.recv()) {
+                    Some(Ok(batch)) => {
+                        self.fed = batch.into_iter();
+                        continue;
+                    }
+                    // the thread ended without a word: taken as the end of the file
+                    _ => Ok(None),
+                },
             };
             match got? {
                 Some((topic, data)) => {
@@ -502,6 +508,7 @@ impl Rosbag2Reader {
                 }
                 None => {
                     self.feed = None;
+                    self.fed = Vec::new().into_iter();
                     if self.next_file == 1 {
                         self.first_topics = std::mem::take(&mut self.seen);
                         self.first_topics.sort_by_key(|t| t.id);
@@ -561,11 +568,7 @@ impl Rosbag2Reader {
 
     fn fail(&mut self, e: EventError, batch: EventBatch) -> Result<Option<EventBatch>> {
         self.done = true;
-        if batch.is_empty() {
-            return Err(e);
-        }
-        self.failed = Some(e);
-        Ok(Some(batch))
+        self.held.fail(e, batch)
     }
 }
 
@@ -575,13 +578,10 @@ impl EventReader for Rosbag2Reader {
     }
 
     fn next_batch(&mut self) -> Result<Option<EventBatch>> {
-        if let Some(b) = self.pending.take() {
-            return Ok(Some(b));
+        match self.held.take() {
+            Some(held) => held,
+            None => self.read_batch(),
         }
-        if let Some(e) = self.failed.take() {
-            return Err(e);
-        }
-        self.read_batch()
     }
 
     fn skipped(&self) -> Vec<(&'static str, u64)> {
@@ -597,25 +597,39 @@ impl EventReader for Rosbag2Reader {
 /// ended it.
 type Fed = Result<Option<(Topic, std::result::Result<Vec<u8>, String>)>>;
 
-/// Messages in flight between the thread reading a file and the decoder.
-const IN_FLIGHT: usize = 16;
+/// Batches in flight between the thread reading a file and the decoder.
+const IN_FLIGHT: usize = 4;
+/// A batch ends past this many bytes or messages: one hand-over, and one wake-up of the
+/// decoder, for many small messages (metavision_driver publishes a few KiB each millisecond).
+const BATCH_BYTES: usize = 1 << 20;
+const BATCH_MESSAGES: usize = 256;
 
 /// Reads `storage` (the file `file`) on a thread of its own, so that SQLite's or MCAP's work
 /// (pages, chunks, zstd) runs beside the decoding of the messages: the messages of the topic
-/// named in `chosen`, or of every topic until one is chosen.
-fn feed(storage: Storage, file: PathBuf, chosen: Arc<OnceLock<String>>) -> Receiver<Fed> {
+/// named in `chosen`, or of every topic until one is chosen, handed on in batches.
+fn feed(storage: Storage, file: PathBuf, chosen: Arc<OnceLock<String>>) -> Receiver<Vec<Fed>> {
     let (tx, rx) = sync_channel(IN_FLIGHT);
     std::thread::spawn(move || {
         let mut storage = storage;
-        loop {
-            let item = match &mut storage {
-                Storage::Sqlite(s) => s.next_of(chosen.get(), &file),
-                Storage::Mcap(m) => m.next_of(chosen.get(), &file),
-            };
-            let item = item.map(|m| m.map(|(t, data)| (t, expand_message(data))));
-            let end = !matches!(item, Ok(Some(_)));
+        let mut end = false;
+        while !end {
+            let mut batch = Vec::new();
+            let mut bytes = 0;
+            while !end && bytes < BATCH_BYTES && batch.len() < BATCH_MESSAGES {
+                let item = match &mut storage {
+                    Storage::Sqlite(s) => s.next_of(chosen.get(), &file),
+                    Storage::Mcap(m) => m.next_of(chosen.get(), &file),
+                };
+                let item = item.map(|m| m.map(|(t, data)| (t, expand_message(data))));
+                match &item {
+                    Ok(Some((_, Ok(data)))) => bytes += data.len(),
+                    Ok(Some(_)) => {}
+                    _ => end = true,
+                }
+                batch.push(item);
+            }
             // a send fails once the reader is dropped: nothing is left to read for
-            if tx.send(item).is_err() || end {
+            if tx.send(batch).is_err() {
                 break;
             }
         }
