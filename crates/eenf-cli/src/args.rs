@@ -422,9 +422,9 @@ impl AudioArgs {
 /// V-ENF flags (`video`).
 #[derive(Debug, Clone, clap::Args)]
 pub struct VideoMethodArgs {
-    /// Grid frequency, 50 or 60 (default: detected from the flicker).
-    #[arg(long, value_parser = number_in(1.0, 1000.0))]
-    pub nominal: Option<f64>,
+    /// Nominal grid frequency: 50, 60, or auto (detected from the flicker).
+    #[arg(long, default_value = "auto")]
+    pub nominal: Nominal,
     /// The sensor's readout time (first row to last row), ms: sets the idle rows.
     #[arg(long, conflicts_with_all = ["idle", "virtual_rows"], value_parser = number_in(0.0, 1000.0))]
     pub readout_ms: Option<f64>,
@@ -453,11 +453,10 @@ pub struct VideoMethodArgs {
 impl VideoMethodArgs {
     /// The V-ENF options these arguments ask for.
     pub fn options(&self) -> Result<VideoOptions> {
-        if let Some(n) = self.nominal {
-            if n != 50.0 && n != 60.0 {
-                bail!("--nominal must be 50 or 60, not {n}");
-            }
-        }
+        let nominal_hz = match self.nominal {
+            Nominal::Hz(f) => Some(f),
+            Nominal::Auto => None,
+        };
         let idle = match (self.readout_ms, self.virtual_rows) {
             (Some(ms), _) if ms > 0.0 => IdleRows::ReadoutS(ms / 1e3),
             (Some(ms), _) => bail!("--readout-ms must be positive, not {ms}"),
@@ -470,13 +469,13 @@ impl VideoMethodArgs {
             other => other,
         };
         let params = EnfParams {
-            nominal_hz: self.nominal.unwrap_or(50.0),
+            nominal_hz: nominal_hz.unwrap_or(50.0),
             window_s: self.window,
             peak: self.peak,
             ..EnfParams::default()
         };
         Ok(VideoOptions {
-            nominal_hz: self.nominal,
+            nominal_hz,
             sampling,
             scene_removal: self.scene_removal,
             params,
@@ -500,13 +499,13 @@ pub struct SimulateArgs {
     #[arg(long, default_value_t = 60.0, value_parser = number_in(0.01, 86_400.0))]
     pub duration: f64,
     /// Where the ENF comes from: `synthetic` (a grid-like random process), a mains WAV or a
-    /// trace CSV (`time_s,enf_hz`, or `index,value` at --enf-step), optionally with a start
+    /// trace CSV (`time_s,enf_hz`, or `index,value` at --index-step), optionally with a start
     /// second (`ref.wav:600`).
     #[arg(long, default_value = "synthetic")]
     pub enf: String,
     /// Seconds between the values of an `index,value` trace CSV.
-    #[arg(long, default_value_t = 2.0, value_parser = number_in(0.001, 3600.0))]
-    pub enf_step: f64,
+    #[arg(long, alias = "enf-step", default_value_t = 2.0, value_parser = number_in(0.001, 3600.0))]
+    pub index_step: f64,
     /// Grid frequency of a synthetic ENF: 50 or 60 (a WAV's or trace's own is detected).
     #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(50..=60))]
     pub grid: u32,
@@ -611,7 +610,7 @@ fn enf_source(a: &SimulateArgs) -> Result<EnfSource> {
     Ok(EnfSource::File {
         path,
         offset_s,
-        index_step_s: a.enf_step,
+        index_step_s: a.index_step,
     })
 }
 
@@ -772,9 +771,10 @@ pub struct StoreInputArgs {
     /// The order of day and month in an archive's dates like 05/06/2022: auto, dmy or mdy.
     #[arg(long, default_value = "auto", value_parser = one_of::<DateOrder>(&DateOrder::NAMES))]
     pub date_order: DateOrder,
-    /// Nominal grid frequency of archives that give deviations: 50 or 60.
-    #[arg(long, value_parser = number_in(40.0, 70.0))]
-    pub nominal: Option<f64>,
+    /// Nominal grid frequency of archives that give deviations: 50, 60, or auto (told from the
+    /// archive's values).
+    #[arg(long, default_value = "auto")]
+    pub nominal: Nominal,
     /// Start time of the first trace CSV (UTC, or with an offset).
     #[arg(long)]
     pub start: Option<String>,
@@ -798,7 +798,10 @@ impl StoreInputArgs {
                 zone: None,
                 unit: self.value_unit,
                 date_order: self.date_order,
-                nominal_hz: self.nominal,
+                nominal_hz: match self.nominal {
+                    Nominal::Hz(f) => Some(f),
+                    Nominal::Auto => None,
+                },
             },
             start: self
                 .start

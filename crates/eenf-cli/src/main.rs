@@ -5,7 +5,7 @@
 use eenf_cli::{commands, terminal};
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// Recover the Electric Network Frequency (ENF) from event-camera recordings.
 ///
@@ -68,7 +68,10 @@ const ALLOCATOR_WARM_UP: usize = 16 << 20;
 
 fn main() -> ExitCode {
     drop(std::hint::black_box(vec![0u8; ALLOCATOR_WARM_UP]));
-    let cli = match Cli::try_parse() {
+    // `--window -3` reaches the flag's own check ("must be positive"), not clap's guess that
+    // `-3` is a flag
+    let matches = negative_numbers(Cli::command()).try_get_matches();
+    let cli = match matches.and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => e.exit(), // --help, --version
         Err(e) => {
@@ -119,8 +122,36 @@ fn main() -> ExitCode {
                 return ExitCode::SUCCESS;
             }
             // one line: the causes joined, each naming what it is about
-            eprintln!("eenf: error: {e:#}");
+            eprintln!("eenf: error: {}", plain_words(&format!("{e:#}")));
             ExitCode::FAILURE
         }
     }
+}
+
+/// `cmd` and its subcommands, taking `-3` as a value: a negative number is a value to check,
+/// not a flag.
+fn negative_numbers(cmd: clap::Command) -> clap::Command {
+    cmd.allow_negative_numbers(true)
+        .mut_subcommands(negative_numbers)
+}
+
+/// An error's text without the OS's error numbers (`(os error 2)`): the words say it.
+fn plain_words(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find(" (os error ") {
+        out.push_str(&rest[..at]);
+        let tail = &rest[at + " (os error ".len()..];
+        match tail.find(')') {
+            Some(end) if tail[..end].bytes().all(|b| b.is_ascii_digit()) => {
+                rest = &tail[end + 1..];
+            }
+            _ => {
+                out.push_str(" (os error ");
+                rest = tail;
+            }
+        }
+    }
+    out.push_str(rest);
+    out
 }

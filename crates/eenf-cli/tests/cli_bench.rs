@@ -62,8 +62,8 @@ fn bench_gives_table_2_and_the_numbers_of_compare_on_the_same_traces() {
     }
     let table = ok(
         &[
-            "-q", "bench", "ds", "--csv", "b.csv", "--json", "b.json", "--report", "r.md",
-            "--traces", "tr", "--plots", "pl",
+            "-q", "bench", "ds", "--csv", "b.csv", "-o", "b.json", "--report", "r.md", "--traces",
+            "tr", "--plots", "pl",
         ],
         d,
     );
@@ -281,6 +281,21 @@ fn a_manifest_places_a_recording_across_an_hour_and_reports_a_corrupt_file() {
     let plain = row("/plain");
     assert_eq!(plain["status"], "ok");
     assert!(num(plain, "mae_hz") < 0.003, "{plain:?}");
+    // without --methods, the methods with no input (no videos here) are named once, not run;
+    // --json prints the numbers instead of the tables
+    let out = eenf(&["-q", "bench", "m2.csv", "--json"], d);
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("not run").count(), 1, "{err}");
+    assert!(err.contains("v-enf-lr, v-enf-hr not run"), "{err}");
+    assert!(!err.contains("failed"), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["methods"], serde_json::json!(["e-enf"]));
+    let mae = v["runs"][0]["recordings"][0]["scores"]["mae_hz"].as_f64();
+    assert!(
+        mae.is_some_and(|m| (m - num(&shifted[0], "mae_hz")).abs() < 1e-9),
+        "{v}"
+    );
 }
 
 #[test]

@@ -288,6 +288,24 @@ fn refdb_and_match_locate_a_clip() {
         d,
     ));
     assert!(w["verify"]["rank"].as_u64().unwrap() > 1, "{w}");
+    // the text ends with a verdict, in UTC and in the zone asked for
+    let text = eenf(&["match", "clip.csv", "store", "--tz", "Asia/Shanghai"], d);
+    let verdict = text.lines().find(|l| l.starts_with("verdict:")).unwrap();
+    assert!(
+        verdict.contains("recorded at 2022-08-17T09:20:34"),
+        "{text}"
+    );
+    assert!(verdict.contains("17:20:34"), "{text}");
+    // 12 values of a grid's wander fit many places: no verdict of a time
+    let short: String = std::fs::read_to_string(d.join("clip.csv"))
+        .unwrap()
+        .lines()
+        .take(13)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(d.join("short.csv"), short).unwrap();
+    let text = eenf(&["match", "short.csv", "store"], d);
+    assert!(text.contains("verdict: no significant match"), "{text}");
     // 60 Hz traces never match a 50 Hz grid
     let sixty: String = std::iter::once("time_s,enf_hz\n".to_string())
         .chain((0..300).map(|i| format!("{i},{}\n", 60.0 + 0.01 * (i as f64 / 30.0).sin())))

@@ -32,12 +32,13 @@ pub use venf::{
 #[derive(Debug, thiserror::Error)]
 pub enum VideoError {
     /// The file could not be read.
-    #[error("{path}: {source}")]
+    // the OS message is shown once: not also as a `source` that `{:#}` would print again
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// The cause.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file is not a usable video.
     #[error("{path}: {reason}")]
@@ -66,7 +67,7 @@ impl VideoError {
     fn io(path: &Path, source: std::io::Error) -> Self {
         VideoError::Io {
             path: path.to_path_buf(),
-            source,
+            error: source,
         }
     }
 

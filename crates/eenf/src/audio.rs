@@ -154,6 +154,9 @@ impl Audio {
 /// read (video containers, other codecs). A damaged packet is skipped; a recording with no
 /// sound is an error.
 pub fn read_audio(path: &Path, opts: &AudioOptions) -> Result<Audio> {
+    if path.is_dir() {
+        bail!("{}: is a folder, not a recording", path.display());
+    }
     let mut file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
     match container_of(&mut file) {
         // Symphonia's Matroska reader panics on cut-short files and allocates whatever a lace

@@ -322,6 +322,21 @@ pub fn utc_micros(us: i64) -> String {
     format!("{}.{micros:06}Z", t.0.strftime("%Y-%m-%dT%H:%M:%S"))
 }
 
+/// The earliest event time read as a date (2000-01-01): cameras that count from their own start
+/// (Prophesee's `.raw`, N-CARS, jAER's relative stamps) give times before it, which name no
+/// wall-clock date.
+pub const WALL_CLOCK_FROM_US: i64 = 946_684_800_000_000;
+
+/// An event time in µs as a reader says it: ISO 8601 UTC when it is a wall-clock time, else
+/// the seconds on the camera's own clock (`12.5 s on the camera's clock, no date`).
+pub fn clock_text(us: i64) -> String {
+    if us >= WALL_CLOCK_FROM_US {
+        utc_micros(us)
+    } else {
+        format!("{:.6} s on the camera's clock, no date", us as f64 / 1e6)
+    }
+}
+
 /// Unix seconds as ISO 8601 UTC, microseconds shown only when not zero:
 /// `2022-08-17T08:10:00Z`.
 pub fn utc(unix_s: f64) -> String {
@@ -335,6 +350,14 @@ mod tests {
     #[test]
     fn utc_formatting() {
         assert_eq!(utc_micros(0), "1970-01-01T00:00:00.000000Z");
+        assert_eq!(
+            clock_text(1_317_888),
+            "1.317888 s on the camera's clock, no date"
+        );
+        assert_eq!(
+            clock_text(1_605_537_493_718_345),
+            "2020-11-16T14:38:13.718345Z"
+        );
         assert_eq!(
             utc_micros(1_660_723_800_000_001),
             "2022-08-17T08:10:00.000001Z"

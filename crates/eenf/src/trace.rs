@@ -13,7 +13,7 @@ use eenf_video::{RowSampling, SceneRemoval, VideoAnalysis, VideoOptions};
 use serde::{Deserialize, Serialize};
 
 /// Seconds between the rows of an `index,value` trace CSV unless told otherwise: the step of
-/// the published 60 Hz ENF traces and of `simulate --enf-step`.
+/// the published 60 Hz ENF traces and of `simulate --index-step`.
 pub const INDEX_STEP_S: f64 = 2.0;
 
 /// The CSV header of trace files; checks outside the code rely on these first two columns.

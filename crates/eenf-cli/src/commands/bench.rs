@@ -22,9 +22,10 @@ pub struct Args {
     /// `<stem>_lr.*`/`<stem>_hr.*` videos, and `ENF_Reference/` with hourly WAVs), or a
     /// manifest CSV (`recording,class,reference,offset_s,videos`, paths relative to it).
     pub dataset: PathBuf,
-    /// Methods to run, comma-separated: e-enf, v-enf-lr, v-enf-hr.
-    #[arg(long, default_value = "e-enf,v-enf-lr,v-enf-hr")]
-    pub methods: String,
+    /// Methods to run, comma-separated: e-enf, v-enf-lr, v-enf-hr. Default: every method whose
+    /// input the dataset has (the video methods need `<stem>_lr.*`/`<stem>_hr.*` videos).
+    #[arg(long)]
+    pub methods: Option<String>,
     /// Recordings processed at once (default: one per core, fewer if the memory budget says so).
     #[arg(long, value_parser = crate::args::count_in(1, 256))]
     pub jobs: Option<usize>,
@@ -34,9 +35,12 @@ pub struct Args {
     /// Write the Markdown report here.
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Write every number as JSON here.
+    /// Print every number as JSON on stdout, instead of the tables.
     #[arg(long)]
-    pub json: Option<PathBuf>,
+    pub json: bool,
+    /// Write every number as JSON here.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
     /// Write every number as CSV here (one row per recording and method, then the means).
     #[arg(long)]
     pub csv: Option<PathBuf>,
@@ -67,8 +71,20 @@ pub struct Args {
 /// Runs `eenf bench`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let started = std::time::Instant::now();
-    let methods = Method::parse_list(&a.methods)?;
     let mut recs = discover(&a.dataset)?;
+    let methods = match &a.methods {
+        Some(list) => Method::parse_list(list)?,
+        None => {
+            let (run, left) = Method::available(&recs);
+            if !left.is_empty() {
+                eprintln!(
+                    "{} not run: no recording has a video from that camera",
+                    left.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")
+                );
+            }
+            run
+        }
+    };
     if a.by == "prominence" {
         group_by_prominence(&mut recs)?;
     }
@@ -121,9 +137,11 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     )?;
     let wall_s = started.elapsed().as_secs_f64();
 
-    // the tables on stdout; failures on stderr
+    // the tables (or JSON) on stdout; failures on stderr
     for run in &runs {
-        outln!("{}", markdown_table(run, &methods));
+        if !a.json {
+            outln!("{}", markdown_table(run, &methods));
+        }
         for o in run.outcomes.iter() {
             if let Err(e) = &o.result {
                 eprintln!(
@@ -170,15 +188,18 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         write_atomic(p, |w| write_csv(w, &recs, &runs))?;
         eprintln!("CSV written to {}", p.display());
     }
-    if let Some(p) = &a.json {
-        let v = serde_json::json!({
-            "dataset": a.dataset,
-            "recordings": recs.len(),
-            "methods": methods,
-            "jobs": jobs,
-            "wall_s": wall_s,
-            "runs": runs.iter().map(|r| json_run(&recs, r)).collect::<Vec<_>>(),
-        });
+    let v = serde_json::json!({
+        "dataset": a.dataset,
+        "recordings": recs.len(),
+        "methods": methods,
+        "jobs": jobs,
+        "wall_s": wall_s,
+        "runs": runs.iter().map(|r| json_run(&recs, r)).collect::<Vec<_>>(),
+    });
+    if a.json {
+        outln!("{}", serde_json::to_string_pretty(&v)?);
+    }
+    if let Some(p) = &a.output {
         write_atomic(p, |w| {
             serde_json::to_writer_pretty(&mut *w, &v)?;
             writeln!(w)?;

@@ -14,9 +14,9 @@ use crate::args::InputArgs;
 pub struct Args {
     /// The event recording.
     pub file: PathBuf,
-    /// The picture (.png or .svg).
-    #[arg(short, long, default_value = "flicker-map.png")]
-    pub output: PathBuf,
+    /// The picture (.png or .svg). Default: `flicker-map.png`, or none with `--json`.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
     /// Tile side, pixels (default: at most 32 tiles across).
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
     pub tile: Option<u16>,
@@ -43,7 +43,14 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         "{}: flicker {whole}; {share:.0} % of the tiles",
         a.file.file_name().unwrap_or_default().to_string_lossy()
     );
-    plot_flicker_map(&a.output, &title, &map)?;
+    let picture = match (&a.output, a.json) {
+        (Some(p), _) => Some(p.clone()),
+        (None, false) => Some(PathBuf::from("flicker-map.png")),
+        (None, true) => None,
+    };
+    if let Some(p) = &picture {
+        plot_flicker_map(p, &title, &map)?;
+    }
     eprintln!(
         "{}: {} x {} tiles of {} pixels over {:.1} s (at most {MAP_SECONDS} s): flicker {whole}; it stands out in {share:.0} % of the tiles",
         a.file.display(),
@@ -52,7 +59,9 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         map.tile,
         map.seconds
     );
-    eprintln!("map written to {}", a.output.display());
+    if let Some(p) = &picture {
+        eprintln!("map written to {}", p.display());
+    }
     if a.json {
         outln!("{}", serde_json::to_string_pretty(&map)?);
     }

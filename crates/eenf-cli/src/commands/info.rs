@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use eenf::inspect::{inspect, CameraFlicker};
-use eenf::time::utc_micros;
+use eenf::time::clock_text;
 
 use crate::args::InputArgs;
 
@@ -106,8 +106,8 @@ pub fn run(a: Args) -> Result<()> {
         stats.events - stats.on
     );
     if let (Some(f), Some(l)) = (stats.first_t, stats.last_t) {
-        outln!("first t     {f} us ({})", utc_micros(f));
-        outln!("last t      {l} us ({})", utc_micros(l));
+        outln!("first t     {f} us ({})", clock_text(f));
+        outln!("last t      {l} us ({})", clock_text(l));
         outln!("duration    {duration_s:.6} s");
         outln!("rate        {:.3} M events/s", rate / 1e6);
     }

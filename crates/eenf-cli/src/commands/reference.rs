@@ -14,7 +14,7 @@ use crate::args::{AudioArgs, TraceOutputArgs, TrackerArgs};
 pub struct Args {
     /// The recording: a mains WAV, or any sound (WAV, FLAC, MP3, M4A/AAC, OGG, or a video's
     /// soundtrack through ffmpeg), at any sample rate.
-    pub wav: PathBuf,
+    pub file: PathBuf,
     #[command(flatten)]
     pub audio: AudioArgs,
     #[command(flatten)]
@@ -29,7 +29,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let spin = progress.spinner("tracking the mains frequency");
     let started = std::time::Instant::now();
     let trace = audio_trace(
-        &a.wav,
+        &a.file,
         &a.audio.options(),
         &a.audio.hum(&a.tracker),
         a.tracker.nominal,
@@ -46,7 +46,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         .sqrt();
     eprintln!(
         "{}: {} Hz grid, {} estimates, mean {mean:.5} Hz, std {:.2} mHz ({} peak) in {:.2} s",
-        a.wav.display(),
+        a.file.display(),
         trace.nominal_hz.unwrap_or(f64::NAN),
         trace.enf_hz.len(),
         sd * 1e3,
@@ -76,7 +76,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             eprintln!("note: {note}");
         }
         for flag in &h.plausibility.flags {
-            eprintln!("warning: {}: {flag}", a.wav.display());
+            eprintln!("warning: {}: {flag}", a.file.display());
         }
     }
     if let Some(&last) = trace.selected.last() {

@@ -25,7 +25,9 @@ pub struct Args {
     /// `manifest.csv` and `dataset.json`.
     pub out_dir: PathBuf,
     /// `ev-enfd`: 51 recordings of 180 s (16 static, 25 dynamic, 10 extreme, the paper's
-    /// proportions); `small`: 9 recordings of 120 s (3 per class).
+    /// proportions); `small`: 9 recordings of 120 s (3 per class); `lamp-spot`: 80 recordings of
+    /// 40 s (eight cameras, DVS128-like and Prophesee, ten each) where only a lamp's pool of
+    /// light flickers.
     #[arg(long, default_value = "ev-enfd")]
     pub preset: String,
     /// Drive the recordings with these real mains WAVs (hourly files named like

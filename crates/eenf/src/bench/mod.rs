@@ -76,6 +76,15 @@ impl Method {
             Method::VEnfHr => Some("hr"),
         }
     }
+
+    /// The methods whose input some recording of `recs` has (E-ENF always; a video method
+    /// when a recording has that camera's video), and those left out.
+    pub fn available(recs: &[Recording]) -> (Vec<Method>, Vec<Method>) {
+        Method::ALL.into_iter().partition(|m| match m.camera() {
+            None => true,
+            Some(camera) => recs.iter().any(|r| r.video(camera).is_some()),
+        })
+    }
 }
 
 /// One class's cell of the paper's table: (class, mean CC, mean MAE in mHz).

@@ -306,22 +306,26 @@ pub fn markdown_report(
     s.push_str("## Parameters\n\n");
     if let Some(run) = runs.first() {
         let e = &run.settings.extract;
-        s.push_str(&format!(
-            "- E-ENF: sampling `{}`, Δt {}, parameters `{}`\n",
-            e.sampling,
-            e.dt_us.map_or(
-                "auto (1000 µs for scan groups, 100 µs otherwise)".into(),
-                |d| format!("{d} µs")
-            ),
-            serde_json::to_string(&e.params).unwrap_or_default()
-        ));
-        let v = &run.settings.video;
-        s.push_str(&format!(
-            "- V-ENF: row sampling `{}`, scene removal `{}`, parameters `{}`\n",
-            serde_json::to_string(&v.sampling).unwrap_or_default(),
-            serde_json::to_string(&v.scene_removal).unwrap_or_default(),
-            serde_json::to_string(&v.params).unwrap_or_default()
-        ));
+        if methods.contains(&Method::EEnf) {
+            s.push_str(&format!(
+                "- E-ENF: sampling {}, Δt {}; {}\n",
+                e.sampling,
+                e.dt_us.map_or(
+                    "auto (1000 µs for scan groups, 100 µs otherwise)".into(),
+                    |d| format!("{d} µs")
+                ),
+                describe_params(&e.params, true)
+            ));
+        }
+        if methods.iter().any(|m| m.camera().is_some()) {
+            let v = &run.settings.video;
+            s.push_str(&format!(
+                "- V-ENF: row sampling {}, scene removal {}; {}\n",
+                v.sampling,
+                v.scene_removal,
+                describe_params(&v.params, false)
+            ));
+        }
     }
     s.push_str("- References: traced as `eenf compare` traces them (default tracker, the estimate's peak refinement); recordings placed by their `dvSave-` name or the manifest's reference and offset, continuing into the next hour's WAV when they run past the hour.\n");
     if !about.sweeps.is_empty() {
@@ -362,4 +366,30 @@ pub fn write_traces(dir: &Path, recs: &[Recording], runs: &[Run]) -> Result<()> 
         }
     }
     Ok(())
+}
+
+/// A tracker's parameters in words, as a report lists them (`harmonics`: whether the method
+/// tracks several flicker lines and selects among them, as E-ENF does; V-ENF tracks 2f0).
+fn describe_params(p: &eenf_dsp::EnfParams, harmonics: bool) -> String {
+    let mut s = format!(
+        "STFT window {} s, step {} s, peak refinement {}, band ±{} Hz (Butterworth order {}), \
+         running median of {} over {} Hz",
+        p.window_s,
+        p.step_s,
+        p.peak,
+        p.half_band_hz,
+        p.filter_order,
+        p.median_len,
+        p.median_threshold_hz
+    );
+    if harmonics {
+        s.push_str(&format!(
+            "; {} flicker line{} (2m·f0), selection {} per {} estimates",
+            p.harmonics,
+            if p.harmonics == 1 { "" } else { "s" },
+            p.selection,
+            p.segment_len
+        ));
+    }
+    s
 }
