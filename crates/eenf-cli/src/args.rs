@@ -319,8 +319,12 @@ impl TraceOutputArgs {
         }
     }
 
-    /// Says where the trace went (stderr).
-    pub fn report(&self) {
+    /// Says where the trace went, and which of its estimates stand at the noise level
+    /// (stderr).
+    pub fn report(&self, trace: &eenf::trace::Trace) {
+        if let Some(note) = trace.noise_note() {
+            eprintln!("warning: {note}");
+        }
         match &self.output {
             Some(out) if eenf::output::is_stdout(out) => {}
             Some(out) => eprintln!("trace written to {}", out.display()),

@@ -276,3 +276,92 @@ fn sound_without_mains_hum_is_refused() {
         assert!(!path.with_extension("csv").exists(), "{}", path.display());
     }
 }
+
+/// Every audio trace says how far each estimate's line stands over its noise (`snr_db`), and
+/// the estimates where the hum has gone (noise alone, past 12 dB in about one window in a
+/// hundred) are named in a warning: 120 s with hum for the first 80 s, noise alone after.
+#[test]
+fn audio_traces_carry_snr_and_flag_estimates_at_the_noise_level() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let fs = 1000u32;
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: fs,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let mut w = hound::WavWriter::create(d.join("fade.wav"), spec).unwrap();
+    let (mut phase, mut state) = (0.0f64, 7u64);
+    for i in 0..fs * 120 {
+        let t = i as f64 / fs as f64;
+        phase += 2.0 * PI * enf_at(t) / fs as f64;
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let noise = ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.2;
+        let hum = if t < 80.0 { 0.05 * phase.sin() } else { 0.0 };
+        w.write_sample(((hum + noise) * 32000.0) as i16).unwrap();
+    }
+    w.finalize().unwrap();
+    let out = cli::eenf(
+        &[
+            "-q",
+            "reference",
+            "fade.wav",
+            "--harmonics",
+            "1",
+            "--nominal",
+            "50",
+            "-o",
+            "t.csv",
+        ],
+        d,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let text = std::fs::read_to_string(d.join("t.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("time_s,enf_hz,snr_db"));
+    let rows: Vec<(f64, Option<f64>, f64)> = lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (
+                f[0].parse().unwrap(),
+                f[1].parse().ok(),
+                f[2].parse().unwrap_or(f64::NAN),
+            )
+        })
+        .collect();
+    // whole windows of hum (16 s) stand well clear; whole windows of noise do not
+    let hum: Vec<f64> = rows.iter().filter(|r| r.0 <= 72.0).map(|r| r.2).collect();
+    let noise: Vec<&(f64, Option<f64>, f64)> = rows.iter().filter(|r| r.0 >= 88.0).collect();
+    assert!(hum.iter().all(|s| *s > 20.0), "{hum:?}");
+    let flagged = noise
+        .iter()
+        .filter(|r| r.1.is_none() || r.2 < eenf_dsp::NOISE_LEVEL_DB)
+        .count();
+    assert!(
+        flagged * 10 >= noise.len() * 9,
+        "{flagged} of {}: {noise:?}",
+        noise.len()
+    );
+    let warning = err
+        .lines()
+        .find(|l| l.contains("stand at the noise level"))
+        .unwrap_or_else(|| panic!("no warning: {err}"));
+    // the stretches it names: all after the hum ended, the last one at the end
+    let spans = warning
+        .split("): ")
+        .nth(1)
+        .unwrap()
+        .split(". ")
+        .next()
+        .unwrap();
+    let times: Vec<f64> = spans
+        .split([',', '–', ' '])
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    assert!(times.iter().all(|t| *t >= 72.0), "{warning}");
+    assert!(times.iter().any(|t| *t >= 110.0), "{warning}");
+}

@@ -354,6 +354,16 @@ fn audibility(harmonics: &[HarmonicEstimates], segment: usize) -> Vec<Vec<bool>>
 /// The reference ENF of a mains (or audio) signal: the same tracker at the fundamental f0,
 /// searched within f0 ± `half_band_hz`. No filtering, as in the method's definition.
 pub fn reference_enf(x: &[f64], fs: f64, p: &EnfParams) -> Result<Vec<f64>, DspError> {
+    reference_enf_with_snr(x, fs, p).map(|(enf, _)| enf)
+}
+
+/// [`reference_enf`], with each window's line strength over its band's median, dB (see
+/// [`StftTracker::track_with_snr`]).
+pub fn reference_enf_with_snr(
+    x: &[f64],
+    fs: f64,
+    p: &EnfParams,
+) -> Result<(Vec<f64>, Vec<f64>), DspError> {
     let duration_s = x.len() as f64 / fs;
     if duration_s < p.window_s {
         return Err(DspError::TooShort {
@@ -368,7 +378,8 @@ pub fn reference_enf(x: &[f64], fs: f64, p: &EnfParams) -> Result<Vec<f64>, DspE
         });
     }
     let band = (p.nominal_hz - p.half_band_hz, p.nominal_hz + p.half_band_hz);
-    let enf = p.tracker(fs).track(x, band);
+    let (enf, snr_db): (Vec<f64>, Vec<f64>) =
+        p.tracker(fs).track_with_snr(x, band).into_iter().unzip();
     if enf.iter().all(|v| !v.is_finite()) {
         return Err(DspError::NoTone(format!(
             "no line inside {:.2}-{:.2} Hz (each window's peak sat at the band's edge)",
@@ -376,7 +387,7 @@ pub fn reference_enf(x: &[f64], fs: f64, p: &EnfParams) -> Result<Vec<f64>, DspE
         )));
     }
     check_near_nominal(&enf, p.nominal_hz)?;
-    Ok(enf)
+    Ok((enf, snr_db))
 }
 
 /// How far from its nominal a grid's frequency may stay for the length of a recording: grids

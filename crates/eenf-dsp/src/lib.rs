@@ -40,8 +40,8 @@ pub use chirp::follow_chirps;
 pub use decimate::{decimate, decimation_for, StreamDecimator};
 pub use enf::{
     check_line, detect_nominal, enf_from_flicker, enf_from_harmonics, enf_from_hum_lines,
-    enf_from_lines, extract_enf, line_prominence, reference_enf, DspError, EnfEstimates, EnfParams,
-    HarmonicEstimates,
+    enf_from_lines, extract_enf, line_prominence, reference_enf, reference_enf_with_snr, DspError,
+    EnfEstimates, EnfParams, HarmonicEstimates,
 };
 pub use filtfilt::sosfiltfilt;
 pub use flicker::{
@@ -57,7 +57,7 @@ pub use postprocess::{
 };
 pub use sampling::{Grouping, PolaritySequence, SamplingError, SamplingMethod, TemporalSampler};
 pub use spectrogram::{spectrogram, Spectrogram};
-pub use tracker::{PeakMethod, StftTracker};
+pub use tracker::{PeakMethod, StftTracker, NOISE_LEVEL_DB};
 
 /// Close to Gaussian noise of unit variance (a sum of twelve uniforms from xorshift64), from
 /// `seed`: the unit tests' noise.

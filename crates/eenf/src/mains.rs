@@ -6,8 +6,8 @@ use std::path::Path;
 use anyhow::{bail, Result};
 use eenf_dsp::hum::{MAX_HUM_HARMONIC, MIN_CLIP_S};
 use eenf_dsp::{
-    check_holds_line, choose_window, enf_from_hum_lines, plausibility, reference_enf, search_hum,
-    EnfParams,
+    check_holds_line, choose_window, enf_from_hum_lines, plausibility, reference_enf_with_snr,
+    search_hum, EnfParams,
 };
 
 use crate::audio::{AudioOptions, Sound};
@@ -164,8 +164,10 @@ pub fn sound_trace(
             window_s: hum.window_s.unwrap_or(params.window_s),
             ..params.clone()
         };
-        let enf = reference_enf(&a.signal.samples, a.signal.fs, &p).map_err(err)?;
+        let (enf, snr_db) =
+            reference_enf_with_snr(&a.signal.samples, a.signal.fs, &p).map_err(err)?;
         let mut t = Trace::from_mains(path, f0, &p, enf);
+        t.snr_db = snr_db;
         if let Some(Provenance::Mains(m)) = t.provenance.as_mut() {
             // a plain mains WAV at its own rate keeps the bare provenance it always had
             if a.source_rate != a.signal.fs || a.channels > 1 || a.decoder != "symphonia" {
@@ -216,8 +218,11 @@ pub fn sound_trace(
     };
     let edge = (window_s / 2.0 / p.step_s).ceil() as usize;
     let mut trace = if f0_alone {
-        let enf = reference_enf(&sig.samples, sig.fs, &p).map_err(err)?;
-        Trace::from_mains(path, f0, &p, enf)
+        let (enf, snr_db) = reference_enf_with_snr(&sig.samples, sig.fs, &p).map_err(err)?;
+        Trace {
+            snr_db,
+            ..Trace::from_mains(path, f0, &p, enf)
+        }
     } else {
         let estimates = enf_from_hum_lines(&sig.samples, sig.fs, &p, &carriers).map_err(err)?;
         Trace::from_mains_lines(

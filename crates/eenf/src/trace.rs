@@ -372,6 +372,60 @@ impl Trace {
         self.enf_hz.iter().copied().filter(|v| v.is_finite())
     }
 
+    /// The estimates whose line stands at the noise level (under
+    /// [`eenf_dsp::NOISE_LEVEL_DB`]), by index; none when the trace did not measure it.
+    pub fn at_noise_level(&self) -> Vec<usize> {
+        (0..self.enf_hz.len())
+            .filter(|&i| {
+                self.enf_hz[i].is_finite()
+                    && self
+                        .snr_db
+                        .get(i)
+                        .is_some_and(|s| *s < eenf_dsp::NOISE_LEVEL_DB)
+            })
+            .collect()
+    }
+
+    /// What a user should know of the estimates at the noise level: how many, and when
+    /// (runs of them as time spans); `None` when there are none.
+    pub fn noise_note(&self) -> Option<String> {
+        let at = self.at_noise_level();
+        if at.is_empty() {
+            return None;
+        }
+        let mut spans: Vec<(usize, usize)> = Vec::new();
+        for &i in &at {
+            match spans.last_mut() {
+                Some((_, end)) if *end + 1 == i => *end = i,
+                _ => spans.push((i, i)),
+            }
+        }
+        let time = |i: usize| {
+            self.time_s
+                .get(i)
+                .copied()
+                .unwrap_or(i as f64 * self.step_s)
+        };
+        let mut shown: Vec<String> = spans
+            .iter()
+            .take(6)
+            .map(|&(a, b)| match a == b {
+                true => format!("{} s", time(a)),
+                false => format!("{}–{} s", time(a), time(b)),
+            })
+            .collect();
+        if spans.len() > 6 {
+            shown.push(format!("and {} more stretches", spans.len() - 6));
+        }
+        let finite = self.enf_hz.iter().filter(|v| v.is_finite()).count();
+        Some(format!(
+            "{} of {finite} estimates stand at the noise level (their line under {} dB over its band; noise alone reaches about 9): {}. Their `snr_db` says which; do not rely on them",
+            at.len(),
+            eenf_dsp::NOISE_LEVEL_DB,
+            shown.join(", ")
+        ))
+    }
+
     /// Mean of the finite estimates (NaN when there are none).
     pub fn mean_hz(&self) -> f64 {
         let (sum, n) = self

@@ -60,7 +60,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             x.events as f64 / took / 1e6
         );
     }
-    a.out.report();
+    a.out.report(&trace);
     if let Some(p) = &a.plot {
         eprintln!("plot written to {}", p.display());
     }

@@ -92,6 +92,6 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             last.harmonic
         );
     }
-    a.out.report();
+    a.out.report(&trace);
     a.out.print(&trace)
 }

@@ -45,6 +45,6 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             trace.mean_hz(),
         );
     }
-    a.out.report();
+    a.out.report(&trace);
     a.out.print(&trace)
 }
