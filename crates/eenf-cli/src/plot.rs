@@ -92,6 +92,58 @@ fn finite_points<'a>(t: &'a [f64], v: &'a [f64]) -> impl Iterator<Item = (f64, f
         .map(|(a, b)| (*a, *b))
 }
 
+/// The runs of consecutive finite values of `v` (a gap breaks the line rather than bridging it).
+fn runs(t: &[f64], v: &[f64]) -> Vec<Vec<(f64, f64)>> {
+    let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut open = false;
+    for (a, b) in t.iter().zip(v) {
+        if b.is_finite() {
+            if !open {
+                out.push(Vec::new());
+                open = true;
+            }
+            if let Some(run) = out.last_mut() {
+                run.push((*a, *b));
+            }
+        } else {
+            open = false;
+        }
+    }
+    out
+}
+
+/// A tick label with `digits` decimals, never `-0.00`.
+fn tick(v: f64, digits: usize) -> String {
+    let text = format!("{v:.digits$}");
+    match text.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+        _ => text,
+    }
+}
+
+/// A tick label of seconds or pixels: whole numbers without decimals.
+fn whole_or_tenths(v: f64) -> String {
+    if (v - v.round()).abs() < 1e-9 {
+        tick(v, 0)
+    } else {
+        tick(v, 1)
+    }
+}
+
+/// A file's name for a figure's title: long names shortened in the middle, so that the title
+/// fits the figure.
+pub fn title_name(path: &Path) -> String {
+    const MOST: usize = 44;
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    let chars: Vec<char> = name.chars().collect();
+    if chars.len() <= MOST {
+        return name.into_owned();
+    }
+    let head: String = chars[..MOST / 2 - 1].iter().collect();
+    let tail: String = chars[chars.len() - (MOST / 2 - 1)..].iter().collect();
+    format!("{head}…{tail}")
+}
+
 type Panel<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// The upper panel of both figures: ENF in Hz over time.
@@ -108,7 +160,8 @@ fn enf_panel<'a, DB: DrawingBackend>(
         .map_err(e)?;
     c.configure_mesh()
         .y_desc("ENF (Hz)")
-        .y_label_formatter(&|v| format!("{v:.3}"))
+        .y_label_formatter(&|v| tick(*v, 3))
+        .x_label_formatter(&|v| whole_or_tenths(*v))
         .draw()
         .map_err(e)?;
     Ok(c)
@@ -200,7 +253,8 @@ fn comparison<DB: DrawingBackend>(
     c.configure_mesh()
         .x_desc("time from recording start (s)")
         .y_desc("error (mHz)")
-        .y_label_formatter(&|v| format!("{v:.2}"))
+        .y_label_formatter(&|v| tick(*v, 2))
+        .x_label_formatter(&|v| whole_or_tenths(*v))
         .draw()
         .map_err(e)?;
     c.draw_series(LineSeries::new([(x.0, 0.0), (x.1, 0.0)], BLACK.mix(0.4)))
@@ -299,7 +353,8 @@ fn spectrogram_chart<DB: DrawingBackend>(
         .disable_mesh()
         .x_desc("time from recording start (s)")
         .y_desc("frequency (Hz)")
-        .y_label_formatter(&|v| format!("{v:.2}"))
+        .y_label_formatter(&|v| tick(*v, 2))
+        .x_label_formatter(&|v| whole_or_tenths(*v))
         .draw()
         .map_err(e)?;
     c.draw_series((0..nt).flat_map(|i| {
@@ -549,25 +604,91 @@ fn extraction<DB: DrawingBackend>(
     let n = tr.enf_hz.len();
     let t = &tr.time_s;
     let x = (0.0, (n.max(2) - 1) as f64 * tr.step_s);
-    let y = range(tr.harmonics.iter().flat_map(|h| h.enf_hz.iter().copied()));
+    // the scale is the selected trace's (at least ±10 mHz): bands that locked on noise run off
+    // it rather than flattening the ENF into a line
+    let y = {
+        let (lo, hi) = range(tr.enf_hz.iter().copied());
+        let (lo, hi) = if lo <= hi && (lo, hi) != (0.0, 1.0) {
+            (lo, hi)
+        } else {
+            range(tr.harmonics.iter().flat_map(|h| h.enf_hz.iter().copied()))
+        };
+        let mid = (lo + hi) / 2.0;
+        let half = ((hi - lo) / 2.0).max(0.01);
+        (mid - half, mid + half)
+    };
     let mut c = enf_panel(&upper, x, y)?;
+    let inside = |v: f64| v >= y.0 && v <= y.1;
     for (k, h) in tr.harmonics.iter().enumerate() {
         let col = PALETTE[k % PALETTE.len()];
-        c.draw_series(LineSeries::new(
-            finite_points(t, &h.enf_hz),
-            col.stroke_width(1),
-        ))
-        .map_err(e)?
-        .label(format!("{} Hz band / {}", h.center_hz, 2 * h.harmonic))
-        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col.stroke_width(2)));
+        let shown: Vec<f64> = h
+            .enf_hz
+            .iter()
+            .map(|&v| if inside(v) { v } else { f64::NAN })
+            .collect();
+        let off = h
+            .enf_hz
+            .iter()
+            .filter(|v| v.is_finite() && !inside(**v))
+            .count();
+        let label = match off {
+            0 => format!("{:.0} Hz band (÷{})", h.center_hz, 2 * h.harmonic),
+            _ => format!(
+                "{:.0} Hz band (÷{}), {off} off the scale",
+                h.center_hz,
+                2 * h.harmonic
+            ),
+        };
+        let mut first = true;
+        for run in runs(t, &shown) {
+            let drawn = c
+                .draw_series(LineSeries::new(run, col.mix(0.45).stroke_width(1)))
+                .map_err(e)?;
+            if std::mem::take(&mut first) {
+                drawn.label(label.clone()).legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], col.mix(0.45).stroke_width(2))
+                });
+            }
+        }
+        if first {
+            // every estimate of the band off the scale (or none): named all the same
+            c.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                .map_err(e)?
+                .label(label)
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], col.mix(0.45).stroke_width(2))
+                });
+        }
     }
-    c.draw_series(LineSeries::new(
-        finite_points(t, &tr.enf_hz),
-        BLACK.stroke_width(3),
-    ))
-    .map_err(e)?
-    .label("selected (ENF)")
-    .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(3)));
+    let mut first = true;
+    for run in runs(t, &tr.enf_hz) {
+        let drawn = c
+            .draw_series(LineSeries::new(run, BLACK.stroke_width(3)))
+            .map_err(e)?;
+        if std::mem::take(&mut first) {
+            drawn
+                .label("ENF (the selected band's)")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(3)));
+        }
+    }
+    let noise: Vec<(f64, f64)> = tr
+        .at_noise_level()
+        .into_iter()
+        .filter_map(|i| Some((*t.get(i)?, tr.enf_hz[i])))
+        .collect();
+    if !noise.is_empty() {
+        c.draw_series(
+            noise
+                .iter()
+                .map(|&p| Circle::new(p, 5, RED.stroke_width(2))),
+        )
+        .map_err(e)?
+        .label(format!(
+            "at the noise level (line under {} dB)",
+            eenf_dsp::NOISE_LEVEL_DB
+        ))
+        .legend(|(x, y)| Circle::new((x + 10, y), 5, RED.stroke_width(2)));
+    }
     legend(&mut c)?;
     let mmax = tr.harmonics.iter().map(|h| h.harmonic).max().unwrap_or(1) as f64;
     let mut c = ChartBuilder::on(&lower)
@@ -578,9 +699,10 @@ fn extraction<DB: DrawingBackend>(
         .map_err(e)?;
     c.configure_mesh()
         .x_desc("time from recording start (s)")
-        .y_desc("harmonic m (2m·f0)")
+        .y_desc("band taken (m: 2m·f0)")
         .y_labels(mmax as usize)
-        .y_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| tick(*v, 0))
+        .x_label_formatter(&|v| whole_or_tenths(*v))
         .draw()
         .map_err(e)?;
     let seg = tr.segment_s().unwrap_or(x.1);
@@ -631,6 +753,7 @@ fn colour_bar<DB: DrawingBackend>(
         .disable_x_axis()
         .y_label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 15))
+        .y_label_formatter(&|v| whole_or_tenths(*v))
         .y_desc(what)
         .draw()
         .map_err(e)?;
@@ -666,6 +789,8 @@ fn flicker_map_chart<DB: DrawingBackend>(
         .disable_mesh()
         .x_desc("x (pixels)")
         .y_desc("y (pixels)")
+        .x_label_formatter(&|v| whole_or_tenths(*v))
+        .y_label_formatter(&|v| whole_or_tenths(*v))
         .draw()
         .map_err(e)?;
     let db = |s: f64| 20.0 * s.max(1e-9).log10();
@@ -699,7 +824,33 @@ fn flicker_map_chart<DB: DrawingBackend>(
             WHITE.stroke_width(1),
         )
     }))
-    .map_err(e)?;
+    .map_err(e)?
+    .label(format!(
+        "mains flicker: the line {:.0} dB or more over the tile's noise",
+        20.0 * eenf::flicker_map::MIN_TILE_STRENGTH.log10()
+    ))
+    .legend(|(x, y)| {
+        Rectangle::new(
+            [(x, y - 6), (x + 16, y + 6)],
+            RGBColor(40, 40, 40).stroke_width(2),
+        )
+    });
+    // grey: a legend entry of its own
+    c.draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
+        .map_err(e)?
+        .label("too few events to tell")
+        .legend(|(x, y)| {
+            Rectangle::new(
+                [(x, y - 6), (x + 16, y + 6)],
+                RGBColor(200, 200, 200).filled(),
+            )
+        });
+    c.configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::LowerRight)
+        .draw()
+        .map_err(e)?;
     colour_bar(&bar_area, (0.0, top_db), "line over noise (dB)")?;
     Ok(())
 }
@@ -782,7 +933,7 @@ fn edits_chart<DB: DrawingBackend>(
         } else {
             3
         };
-        let fmt = move |v: &f64| format!("{v:.digits$}");
+        let fmt = move |v: &f64| tick(*v, digits);
         let mut mesh = c.configure_mesh();
         mesh.x_label_formatter(&|v| format!("{v:.0}"))
             .y_desc(y_desc)

@@ -68,7 +68,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     if let Some(p) = &a.plot {
         let title = format!(
             "{} vs {}: CC {:.4}, MAE {:.2} mHz",
-            a.estimate.file_name().unwrap_or_default().to_string_lossy(),
+            crate::plot::title_name(&a.estimate),
             a.reference
                 .file_name()
                 .unwrap_or_default()

@@ -41,11 +41,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         eenf::output::write_atomic(out, |w| Ok(w.write_all(report.to_json().as_bytes())?))?;
     }
     if let Some(plot) = &a.plot {
-        let title = format!(
-            "{}: {}",
-            a.file.file_name().unwrap_or_default().to_string_lossy(),
-            report.verdict
-        );
+        let title = format!("{}: {}", crate::plot::title_name(&a.file), report.verdict);
         crate::plot::plot_edits(plot, &title, &report)?;
     }
     let lines: Vec<String> = report.lines_hz.iter().map(|f| format!("{f:.0}")).collect();

@@ -32,8 +32,8 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     a.out.save(&trace)?;
     if let Some(p) = &a.plot {
         let title = format!(
-            "{}: ENF per harmonic, selected per {} s",
-            a.file.file_name().unwrap_or_default().to_string_lossy(),
+            "{}: ENF, and each band's estimate (the band taken per {} s below)",
+            crate::plot::title_name(&a.file),
             trace.segment_s().unwrap_or(0.0)
         );
         plot_extraction(p, &title, &trace)?;

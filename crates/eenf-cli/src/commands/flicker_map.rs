@@ -39,10 +39,15 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         None => "no line measured".to_string(),
     };
     let share = 100.0 * map.flickering_share();
-    let title = format!(
-        "{}: flicker {whole}; {share:.0} % of the tiles",
-        a.file.file_name().unwrap_or_default().to_string_lossy()
-    );
+    let title = match map.whole {
+        Some(l) => format!(
+            "{}: flicker at {:.3} Hz, {:.0} dB over the noise; it stands out in {share:.0} % of the tiles",
+            crate::plot::title_name(&a.file),
+            l.hz,
+            l.db()
+        ),
+        None => format!("{}: no flicker line measured", crate::plot::title_name(&a.file)),
+    };
     let picture = match (&a.output, a.json) {
         (Some(p), _) => Some(p.clone()),
         (None, false) => Some(PathBuf::from("flicker-map.png")),

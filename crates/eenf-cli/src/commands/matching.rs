@@ -71,7 +71,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             p,
             &format!(
                 "{} at {}: CC {:.4}, p {:.1e}",
-                a.trace.file_name().unwrap_or_default().to_string_lossy(),
+                crate::plot::title_name(&a.trace),
                 when(r, c.offset),
                 c.agreement.cc,
                 c.p_value
