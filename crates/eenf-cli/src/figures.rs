@@ -110,7 +110,11 @@ pub fn write_plots(
             })
             .collect();
         let names: Vec<String> = methods.iter().map(|m| m.label().to_string()).collect();
-        let title = format!("{} recordings, {}", recs.len(), run.settings.describe());
+        let title = format!(
+            "eenf on {} recordings ({}), beside the paper's Table 2",
+            recs.len(),
+            run.settings.describe()
+        );
         let name = if runs.len() == 1 {
             "summary".to_string()
         } else {

@@ -472,6 +472,15 @@ where
         })
         .x_desc("scene class")
         .y_desc(p.y_desc)
+        .y_label_formatter(&|v| {
+            if *v >= 1.0 {
+                whole_or_tenths(*v)
+            } else {
+                // CC and small MAE: as few decimals as the value needs
+                let t = tick(*v, 3);
+                t.trim_end_matches('0').trim_end_matches('.').to_string()
+            }
+        })
         .draw()
         .map_err(e)?;
     for (k, m) in methods.iter().enumerate() {
