@@ -361,4 +361,11 @@ fn the_flicker_map_of_a_lamp_lit_room_flickers_everywhere() {
         assert!(s.as_f64().unwrap() > 10.0, "{s}");
     }
     assert!(d.join("map.svg").metadata().unwrap().len() > 1000);
+    // --json alone prints the map and draws nothing unasked
+    let again = json(&eenf(
+        &["-q", "flicker-map", "room.aedat4", "--tile", "8", "--json"],
+        d,
+    ));
+    assert_eq!(again["cols"], map["cols"]);
+    assert!(!d.join("flicker-map.png").exists());
 }

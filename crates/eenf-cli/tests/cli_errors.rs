@@ -54,6 +54,18 @@ fn bad_inputs_give_one_line_errors() {
         "no such file",
     );
     fails(&["info", "nope.aedat4"], d, "nope.aedat4", "no such file");
+    // the OS's words once, without its error number
+    for cmd in ["video", "audio", "compare", "info"] {
+        let args: Vec<&str> = match cmd {
+            "compare" => vec![cmd, "nope.csv", "nope.csv"],
+            _ => vec![cmd, "nope.csv"],
+        };
+        let (_, _, err) = eenf(&args, d);
+        assert_eq!(err.matches("No such file").count(), 1, "{err}");
+        assert!(!err.contains("os error"), "{err}");
+    }
+    std::fs::create_dir(d.join("folder")).unwrap();
+    fails(&["audio", "folder"], d, "folder", "is a folder");
 
     std::fs::write(d.join("notes.txt"), "hello world\nthis is not events\n").unwrap();
     fails(
@@ -393,6 +405,8 @@ fn absurd_flags_are_one_line_errors_with_the_range() {
             "--median-len",
         ),
         (vec!["extract", "x.aedat4", "--window", "nan"], "--window"),
+        // a negative number is the flag's value, refused by its range, not taken for a flag
+        (vec!["extract", "x.aedat4", "--window", "-3"], "--window"),
         (vec!["reference", "x.wav", "--step", "1e-300"], "--step"),
         (vec!["simulate", "--duration", "1e12"], "--duration"),
         (vec!["match", "t.csv", "t.csv", "--alpha", "7"], "--alpha"),
