@@ -944,7 +944,7 @@ fn edits_chart<DB: DrawingBackend>(
         };
         let fmt = move |v: &f64| tick(*v, digits);
         let mut mesh = c.configure_mesh();
-        mesh.x_label_formatter(&|v| format!("{v:.0}"))
+        mesh.x_label_formatter(&|v| whole_or_tenths(*v))
             .y_desc(y_desc)
             .y_label_formatter(&fmt);
         if i == last {
@@ -1014,12 +1014,22 @@ fn edits_chart<DB: DrawingBackend>(
             None,
         )?;
         k += 1;
+        // a strong edit stands hundreds of times over the threshold: the scale stops at a few
+        // times it, so that the threshold and the weaker peaks stay in view
+        const CAP: f64 = 4.0;
+        let strength = thinned(&s.time_s, &s.strength);
+        let clipped = strength.iter().any(|p| p.1 > CAP);
+        let label = if clipped {
+            format!("phase-jump test (cut off at {CAP:.0}×)")
+        } else {
+            "phase-jump test".to_string()
+        };
         panel(
             &areas[k],
             "test statistic / threshold",
-            thinned(&s.time_s, &s.strength),
+            strength.into_iter().map(|(t, v)| (t, v.min(CAP))).collect(),
             PALETTE[1],
-            "phase-jump test",
+            &label,
             Some(1.0),
         )?;
         k += 1;
