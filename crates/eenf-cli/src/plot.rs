@@ -616,9 +616,8 @@ fn extraction<DB: DrawingBackend>(
     // the scale is the selected trace's (at least ±10 mHz): bands that locked on noise run off
     // it rather than flattening the ENF into a line
     let y = {
-        let (lo, hi) = range(tr.enf_hz.iter().copied());
-        let (lo, hi) = if lo <= hi && (lo, hi) != (0.0, 1.0) {
-            (lo, hi)
+        let (lo, hi) = if tr.finite().next().is_some() {
+            range(tr.enf_hz.iter().copied())
         } else {
             range(tr.harmonics.iter().flat_map(|h| h.enf_hz.iter().copied()))
         };

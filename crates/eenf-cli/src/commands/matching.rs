@@ -127,15 +127,14 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         );
     }
     // the answer in one line: a table alone leaves a reader to judge rank 1 at CC 0.91
-    match rows.first() {
-        Some((r, c)) if c.p_value < query.alpha => outln!(
-            "verdict: recorded at {} (CC {:.4}, p {:.1e} < {})",
-            when(r, c.offset),
+    match rows.first().zip(labels.first()) {
+        Some(((_, c), label)) if c.p_value < query.alpha => outln!(
+            "verdict: recorded at {label} (CC {:.4}, p {:.1e} < {})",
             c.agreement.cc,
             c.p_value,
             query.alpha
         ),
-        Some((_, c)) => outln!(
+        Some(((_, c), _)) => outln!(
             "verdict: no significant match (the best place has p {:.1e}, not below {}): the trace does not tell when it was recorded",
             c.p_value,
             query.alpha
