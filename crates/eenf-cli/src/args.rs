@@ -685,7 +685,9 @@ pub struct EditArgs {
     /// Nominal grid frequency: 50, 60, or auto (from the hum).
     #[arg(long, default_value = "auto")]
     pub nominal: Nominal,
-    /// The longest stretch whose phase is fitted on each side of a boundary, s.
+    /// The longest stretch whose phase is fitted on each side of a boundary, s: each recording
+    /// is tested at the side up to this (2, 3, 5 or 10 s) whose smallest detectable jump is
+    /// smallest, given its noise and the real grid's stray at that side.
     #[arg(long, default_value_t = EditParams::default().side_s, value_parser = number_in(1.0, 600.0))]
     pub side: f64,
     /// The shortest stretch between two edits told apart, s (also the shortest side fitted:
@@ -693,7 +695,9 @@ pub struct EditArgs {
     #[arg(long, default_value_t = EditParams::default().min_gap_s, value_parser = number_in(0.3, 600.0))]
     pub min_gap: f64,
     /// False alarms allowed per hour of unedited recording: sets the phase test's threshold
-    /// from the noise measured in the recording.
+    /// from the noise measured in the recording and the real grid's own phase stray, measured
+    /// on 24 continuous hours of real mains (0 findings there at the default 0.05, 95 % upper
+    /// bound 0.12 per hour; in a phone's noise 3 in 130 hours of clips of them).
     #[arg(long, default_value_t = EditParams::default().false_alarms_per_hour, value_parser = number_in(1e-9, 100.0))]
     pub false_alarms: f64,
     /// Report stretches where a phase jump this large (degrees of the lowest line) would go

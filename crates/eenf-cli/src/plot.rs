@@ -910,11 +910,20 @@ fn edits_chart<DB: DrawingBackend>(
     );
     let has_phase = !s.phase_deg.is_empty();
     let areas = root.split_evenly((if has_phase { 3 } else { 1 }, 1));
-    let marks: Vec<(f64, bool)> = r
+    let marks: Vec<(f64, bool, f64)> = r
         .edits
         .iter()
-        .map(|ed| (ed.time_s, ed.kind == eenf::edits::EditKind::HumGap))
+        .map(|ed| {
+            (
+                ed.time_s,
+                ed.kind == eenf::edits::EditKind::HumGap,
+                ed.strength,
+            )
+        })
         .collect();
+    // a strong edit stands hundreds of times over the threshold: the test's scale stops at a
+    // few times it, so that the threshold and the weaker peaks stay in view
+    const CAP: f64 = 4.0;
     let mut i = 0;
     let last = areas.len() - 1;
     let mut panel = |area: &DrawingArea<DB, Shift>,
@@ -922,7 +931,8 @@ fn edits_chart<DB: DrawingBackend>(
                      pts: Vec<(f64, f64)>,
                      colour: RGBColor,
                      label: &str,
-                     threshold: Option<f64>|
+                     threshold: Option<f64>,
+                     peaks: bool|
      -> Result<()> {
         let (lo, hi) = range(pts.iter().map(|p| p.1).chain(threshold));
         let mut c = ChartBuilder::on(area)
@@ -970,15 +980,30 @@ fn edits_chart<DB: DrawingBackend>(
             .label("threshold")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(1)));
         }
-        for (k, &(t, gap)) in marks.iter().enumerate() {
+        // each finding: a faint line (the curve stays visible through it), its number at the
+        // top, and on the test's panel a ring on its own peak
+        for (k, &(t, gap, strength)) in marks.iter().enumerate() {
             let col = if gap { PALETTE[3] } else { RED };
             let series = c
-                .draw_series(LineSeries::new([(t, lo), (t, hi)], col.stroke_width(2)))
+                .draw_series(LineSeries::new(
+                    [(t, lo), (t, hi)],
+                    col.mix(0.35).stroke_width(1),
+                ))
                 .map_err(e)?;
             if k == 0 {
-                series.label("edit found").legend(move |(x, y)| {
+                series.label("finding (numbered)").legend(move |(x, y)| {
                     PathElement::new([(x, y), (x + 20, y)], col.stroke_width(2))
                 });
+            }
+            c.draw_series([Text::new(
+                format!("{}", k + 1),
+                (t, hi),
+                ("sans-serif", 14).into_font().color(&col),
+            )])
+            .map_err(e)?;
+            if peaks && !gap {
+                c.draw_series([Circle::new((t, strength.min(CAP)), 5, col.stroke_width(2))])
+                    .map_err(e)?;
             }
         }
         if !r.undecided.is_empty() {
@@ -1009,19 +1034,20 @@ fn edits_chart<DB: DrawingBackend>(
             ),
             thinned(&s.time_s, &s.phase_deg),
             PALETTE[0],
-            "hum phase minus its smooth fit",
+            "hum phase minus its 20 s running mean",
             None,
+            false,
         )?;
         k += 1;
-        // a strong edit stands hundreds of times over the threshold: the scale stops at a few
-        // times it, so that the threshold and the weaker peaks stay in view
-        const CAP: f64 = 4.0;
         let strength = thinned(&s.time_s, &s.strength);
         let clipped = strength.iter().any(|p| p.1 > CAP);
+        let side = r
+            .tested_side_s
+            .map_or(String::new(), |s| format!(", {s:.0} s sides"));
         let label = if clipped {
-            format!("phase-jump test (cut off at {CAP:.0}×)")
+            format!("phase-jump test as decided{side} (cut off at {CAP:.0}×)")
         } else {
-            "phase-jump test".to_string()
+            format!("phase-jump test as decided{side}")
         };
         panel(
             &areas[k],
@@ -1030,6 +1056,7 @@ fn edits_chart<DB: DrawingBackend>(
             PALETTE[1],
             &label,
             Some(1.0),
+            true,
         )?;
         k += 1;
     }
@@ -1046,6 +1073,7 @@ fn edits_chart<DB: DrawingBackend>(
         PALETTE[2],
         "ENF",
         None,
+        false,
     )?;
     Ok(())
 }

@@ -88,7 +88,7 @@ fn a_cut_is_reported_at_its_place_with_its_phase_jump_and_the_whole_clip_is_not(
         assert!(e[key].as_f64().is_some(), "{key} missing: {e}");
     }
     assert!(e["strength"].as_f64().unwrap() >= 1.0);
-    assert!(r["verdict"].as_str().unwrap().starts_with("edited"));
+    assert!(r["verdict"].as_str().unwrap().starts_with("discontinuous"));
     assert_eq!(r["grid_hz"].as_f64(), Some(50.0));
     let svg = std::fs::read_to_string(d.join("cut.svg")).unwrap();
     assert!(svg.contains("phase deviation") && svg.contains("threshold"));

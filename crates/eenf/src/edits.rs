@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
-use eenf_dsp::edits::{baseband, false_alarms_per_hour, scan_phase, wrap, BoundaryTest, PhaseScan};
+use eenf_dsp::edits::{baseband, scan_phase, wrap, Baseband, BoundaryTest, PhaseScan};
 use eenf_dsp::hum::{MAX_HUM_HARMONIC, MIN_CLIP_S};
 use eenf_dsp::search_hum;
 use serde::Serialize;
@@ -80,10 +80,14 @@ pub struct Edit {
     pub frequency_step_z: Option<f64>,
     /// The test's statistic over its threshold (≥ 1 when reported for a phase jump).
     pub strength: f64,
-    /// How often noise alone reaches this strength per hour of unedited recording.
+    /// How often a recording nobody edited shows a break this strong, per hour: the
+    /// recording's noise and the real grid's own stray (see `eenf_dsp::edits::null`).
     pub false_alarms_per_hour: f64,
-    /// The chance that noise alone reaches it anywhere in the stretch examined.
+    /// The chance that an unedited recording shows one anywhere in the stretch examined.
     pub p_value: f64,
+    /// What the data show and what they are consistent with: the phase cannot tell a cut
+    /// from an insertion or from a recorder that dropped or inverted samples.
+    pub reading: String,
 }
 
 /// A stretch of the recording.
@@ -104,8 +108,8 @@ pub struct EditSeries {
     pub time_s: Vec<f64>,
     /// The hum's phase deviation from a smooth fit, degrees of the lowest line.
     pub phase_deg: Vec<f64>,
-    /// The test's statistic over its threshold before any edit was taken out (NaN where not
-    /// tested): edits stand as peaks.
+    /// The test's statistic over its threshold as the verdict was decided (NaN where not
+    /// tested): each finding at its own test, nothing else at 1 or more.
     pub strength: Vec<f64>,
     /// The ENF, Hz.
     pub enf_hz: Vec<f64>,
@@ -135,6 +139,10 @@ pub struct EditReport {
     pub min_jump_deg: Option<f64>,
     /// The threshold of the phase test (its statistic, see `eenf_dsp::edits`).
     pub threshold: Option<f64>,
+    /// The side each boundary was tested with, s (the one, up to `--side`, whose smallest
+    /// detectable jump is smallest in this recording).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tested_side_s: Option<f64>,
     /// One line for the reader: edited, not shown to be edited, or cannot tell.
     pub verdict: String,
     /// The parameters used.
@@ -256,6 +264,29 @@ pub fn sound_edits(
     params: &EditParams,
 ) -> Result<EditReport> {
     let path = sound.name();
+    let hum = sound_baseband(sound, audio, nominal)?;
+    let scan =
+        scan_phase(&hum.baseband, params).ok_or_else(|| too_short(path, hum.duration_s, params))?;
+    let mut r = report(path, "audio", &scan, hum.duration_s);
+    r.warnings.extend(hum.warning);
+    Ok(r)
+}
+
+/// A sound's hum at baseband: the lines the detector picks, ready for the phase test.
+#[derive(Debug, Clone)]
+pub struct SoundHum {
+    /// The lines at baseband.
+    pub baseband: Baseband,
+    /// The sound's length, s.
+    pub duration_s: f64,
+    /// Damage the decoder skipped, if any.
+    pub warning: Option<String>,
+}
+
+/// Reads a sound and brings the lines that carry its hum to baseband (a sound with no hum is
+/// refused, as `audio` refuses it).
+pub fn sound_baseband(sound: &Sound, audio: &AudioOptions, nominal: Nominal) -> Result<SoundHum> {
+    let path = sound.name();
     let err = |e: eenf_dsp::DspError| anyhow!("{}: {e}", path.display());
     let grids = grids_of(nominal);
     let top_grid = grids.iter().fold(0.0f64, |a, &b| a.max(b));
@@ -285,11 +316,11 @@ pub fn sound_edits(
     let highest = carriers.last().copied().unwrap_or(1);
     let sig = a.narrowed(top_of(highest));
     let multiples: Vec<u32> = carriers.iter().map(|&k| k as u32).collect();
-    let bb = baseband(&sig.samples, sig.fs, verdict.grid_hz, &multiples);
-    let scan = scan_phase(&bb, params).ok_or_else(|| too_short(path, duration_s, params))?;
-    let mut r = report(path, "audio", &scan, duration_s);
-    r.warnings.extend(a.warning);
-    Ok(r)
+    Ok(SoundHum {
+        baseband: baseband(&sig.samples, sig.fs, verdict.grid_hz, &multiples),
+        duration_s,
+        warning: a.warning,
+    })
 }
 
 /// The edits of an event recording, from the flicker signal E-ENF samples (light flickers at
@@ -332,6 +363,13 @@ pub fn event_edits(
 
 /// The longest side of the frequency-step test on a trace, s.
 const TRACE_SIDE_S: f64 = 5.0;
+
+/// How often real continuous traces show a frequency step of z robust standard deviations:
+/// `A·e^(−z/b)` per hour, measured on 96 hours (the 24 hours of `../shared/mains-day` and
+/// `enf-reference` traced by `audio`, the three 60 Hz days of `enf-traces-60hz` at 2 s;
+/// `tools/trace_null.py`): fitted to the rates between 0.1 and 10 per hour (b = 0.694) and
+/// raised to bound every rate resting on two peaks or more (A = 1325, rounded up).
+const TRACE_STEP_TAIL: (f64, f64) = (1400.0, 0.694);
 
 /// Frequency steps in an ENF trace (no phase to test): at each estimate, a line fitted to the
 /// `side_s` after it and one fitted to the `side_s` before, both carried to the boundary; the
@@ -377,9 +415,11 @@ pub fn trace_edits(trace: &Trace, path: &Path, params: &EditParams) -> Result<Ed
         .collect();
     let scale = robust_scale(steps.iter().map(|s| s.1));
     let duration_s = n as f64 * step;
+    let hours = ((n - 2 * side) as f64 * step / 3600.0).max(1e-9);
     let mut edits = Vec::new();
     for (i, d) in peaks(&steps, side, scale, params.frequency_step_z) {
         let z = d / scale;
+        let rate = TRACE_STEP_TAIL.0 * (-z.abs() / TRACE_STEP_TAIL.1).exp();
         edits.push(Edit {
             time_s: trace.time_s.get(i).copied().unwrap_or(i as f64 * step) - step / 2.0,
             end_s: None,
@@ -390,8 +430,13 @@ pub fn trace_edits(trace: &Trace, path: &Path, params: &EditParams) -> Result<Ed
             frequency_step_mhz: Some(d * 1e3),
             frequency_step_z: Some(z),
             strength: z.abs() / params.frequency_step_z,
-            false_alarms_per_hour: f64::NAN,
-            p_value: f64::NAN,
+            false_alarms_per_hour: rate,
+            p_value: -(-rate * hours).exp_m1(),
+            reading: format!(
+                "the ENF steps by {:+.1} mHz, {:.0} times the trace's own spread of steps: consistent with a cut or an insertion from another time, or with a sudden change of load on the grid",
+                d * 1e3,
+                z.abs()
+            ),
         });
     }
     let verdict = if edits.is_empty() {
@@ -415,6 +460,7 @@ pub fn trace_edits(trace: &Trace, path: &Path, params: &EditParams) -> Result<Ed
         undecided: Vec::new(),
         min_jump_deg: None,
         threshold: None,
+        tested_side_s: None,
         verdict,
         params: params.clone(),
         warnings: trace.warnings.clone(),
@@ -458,12 +504,28 @@ fn peaks(values: &[(usize, f64)], radius: usize, scale: f64, z: f64) -> Vec<(usi
     kept
 }
 
+/// What a break in the phase shows and what it is consistent with (the phase cannot tell
+/// intent: a cut, an insertion and a recorder's fault all break it).
+fn phase_reading(kind: EditKind, jump_deg: f64, line_hz: f64, step_hz: f64) -> String {
+    let shift_ms = jump_deg / 360.0 / line_hz * 1e3;
+    let what = format!("the {line_hz:.0} Hz hum's phase turns by {jump_deg:+.0}° at once ({shift_ms:+.2} ms of the hum's time)");
+    if jump_deg.abs() >= 150.0 && kind == EditKind::PhaseJump {
+        format!("{what}, about half a cycle: consistent with inverted samples, or with a cut or an insertion of a whole number of cycles and a half")
+    } else if kind == EditKind::PhaseJumpAndFrequencyStep {
+        format!(
+            "{what} and the ENF steps by {:+.1} mHz: consistent with a cut, or an insertion of material recorded at another time",
+            step_hz * 1e3
+        )
+    } else {
+        format!("{what}: consistent with a cut, an insertion, or the recorder dropping samples")
+    }
+}
+
 /// The report of a phase scan (times from the recording's start).
 fn report(path: &Path, input: &'static str, scan: &PhaseScan, duration_s: f64) -> EditReport {
     let p = &scan.params;
     let tb = scan.block_s;
     let lowest = scan.multiples.first().copied().unwrap_or(1) as f64;
-    let lines = scan.multiples.len();
     let at = |block: usize| block as f64 * tb;
     let examined = match (scan.tests.first(), scan.tests.last()) {
         (Some(a), Some(b)) => [at(a.block), at(b.block)],
@@ -476,19 +538,21 @@ fn report(path: &Path, input: &'static str, scan: &PhaseScan, duration_s: f64) -
         .jumps
         .iter()
         .map(|t: &BoundaryTest| {
-            let fa = false_alarms_per_hour(t.statistic, lines, p);
+            let fa = t.false_alarms_per_hour;
             let step = Some(t.frequency_step_hz);
             let z = step.map(|s| s / scale);
             let stepped = z.is_some_and(|z| z.abs() >= p.frequency_step_z);
             let jump = wrap(lowest * t.jump_rad).to_degrees();
+            let kind = if stepped {
+                EditKind::PhaseJumpAndFrequencyStep
+            } else {
+                EditKind::PhaseJump
+            };
             Edit {
                 time_s: at(t.block),
                 end_s: None,
-                kind: if stepped {
-                    EditKind::PhaseJumpAndFrequencyStep
-                } else {
-                    EditKind::PhaseJump
-                },
+                kind,
+                reading: phase_reading(kind, jump, lowest * scan.f0_hz, t.frequency_step_hz),
                 phase_jump_deg: Some(jump),
                 phase_jump_line_hz: Some(lowest * scan.f0_hz),
                 time_shift_ms: Some(jump / 360.0 / (lowest * scan.f0_hz) * 1e3),
@@ -496,7 +560,8 @@ fn report(path: &Path, input: &'static str, scan: &PhaseScan, duration_s: f64) -
                 frequency_step_z: z,
                 strength: t.statistic / scan.threshold,
                 false_alarms_per_hour: fa,
-                p_value: 1.0 - (-fa * hours).exp(),
+                // exp_m1 keeps the small p-values that 1 − e^(−x) would round to 0
+                p_value: -(-fa * hours).exp_m1(),
             }
         })
         .collect();
@@ -529,6 +594,10 @@ fn report(path: &Path, input: &'static str, scan: &PhaseScan, duration_s: f64) -
                         strength: typical / scan.presence_threshold,
                         false_alarms_per_hour: f64::NAN,
                         p_value: f64::NAN,
+                        reading: format!(
+                            "the hum, clear elsewhere, vanishes for {} s: consistent with an insertion of other material or silence, or with the recorder losing its input",
+                            i - start
+                        ),
                     });
                 }
             }
@@ -537,9 +606,7 @@ fn report(path: &Path, input: &'static str, scan: &PhaseScan, duration_s: f64) -
     }
     edits.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
     // where a jump as large as `weak_jump_deg` would go unseen
-    let min_jump = |t: &BoundaryTest| -> f64 {
-        (lowest * (scan.threshold / t.precision.max(1e-300)).sqrt()).to_degrees()
-    };
+    let min_jump = |t: &BoundaryTest| -> f64 { (lowest * t.min_jump_rad).to_degrees() };
     let mut undecided = Vec::new();
     let mut run: Option<(f64, f64)> = None;
     for t in &scan.tests {
@@ -580,7 +647,7 @@ fn report(path: &Path, input: &'static str, scan: &PhaseScan, duration_s: f64) -
     let span = examined[1] - examined[0];
     let verdict = if !edits.is_empty() {
         format!(
-            "edited: {} finding{} (see edits)",
+            "discontinuous: {} break{} in the hum (see edits)",
             edits.len(),
             if edits.len() == 1 { "" } else { "s" }
         )
@@ -599,7 +666,7 @@ fn report(path: &Path, input: &'static str, scan: &PhaseScan, duration_s: f64) -
     let n = scan.enf_hz.len();
     let strength: Vec<f64> = (0..n)
         .map(|b| {
-            scan.first_pass
+            scan.statistic
                 .get(b)
                 .map_or(f64::NAN, |t| t / scan.threshold)
         })
@@ -619,6 +686,7 @@ fn report(path: &Path, input: &'static str, scan: &PhaseScan, duration_s: f64) -
         undecided,
         min_jump_deg,
         threshold: Some(scan.threshold),
+        tested_side_s: Some(scan.side_s),
         verdict,
         params: p.clone(),
         warnings: Vec::new(),

@@ -39,7 +39,14 @@ pub fn remove_in_progress() {
     let paths = IN_PROGRESS.lock().map(|v| v.clone()).unwrap_or_default();
     for p in paths.iter().rev() {
         if p.is_dir() {
-            let _ = std::fs::remove_dir_all(p);
+            // threads still writing into the folder can add a file while it is being emptied
+            // ("directory not empty"): try again for a little while
+            for _ in 0..50 {
+                if std::fs::remove_dir_all(p).is_ok() || !p.exists() {
+                    break;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(10));
+            }
         } else {
             let _ = std::fs::remove_file(p);
         }

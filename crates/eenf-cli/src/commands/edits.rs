@@ -85,12 +85,24 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             parts.push(format!("strength {:.1}", e.strength));
             if e.false_alarms_per_hour.is_finite() {
                 parts.push(format!(
-                    "{:.1e} false alarms/h, p {:.1e}",
-                    e.false_alarms_per_hour, e.p_value
+                    "{} false alarms/h, p {}",
+                    small(e.false_alarms_per_hour),
+                    small(e.p_value)
                 ));
             }
             outln!("{}", parts.join(", "));
+            outln!("             {}", e.reading);
         }
     }
     Ok(())
+}
+
+/// A rate or a probability for the reader: two digits, and below 1e-12 only a bound (the
+/// model says no more than that so far into its tail).
+fn small(v: f64) -> String {
+    if v < 1e-12 {
+        "< 1e-12".to_string()
+    } else {
+        format!("{v:.1e}")
+    }
 }

@@ -429,9 +429,11 @@ def edits(
     (``eenf edits``): a file (sound in any container ``reference`` reads, an event file, or an
     ENF trace for frequency steps alone), or sound samples in memory at ``fs`` Hz.
 
-    Returns the report ``eenf edits --json`` prints, as a dict (``edits``: each with
-    ``time_s``, ``kind``, ``phase_jump_deg``, ``strength``, ``false_alarms_per_hour``,
-    ``p_value``, …; ``undecided``: stretches too weak to tell; ``verdict``), with
+    Returns the report ``eenf edits --json`` prints, as a dict (``edits``: each break with
+    ``time_s``, ``kind``, ``phase_jump_deg``, ``strength``, ``false_alarms_per_hour`` and
+    ``p_value`` from the null model calibrated on real mains, ``reading``: what the break is
+    consistent with, …; ``undecided``: stretches too weak to tell; ``tested_side_s``;
+    ``verdict``), with
     ``series``: numpy arrays ``time_s``, ``phase_deg``, ``strength`` and ``enf_hz`` (the
     figure's data)."""
     if _is_path(source):

@@ -28,3 +28,22 @@ pub fn reference_wavs() -> Vec<PathBuf> {
     wavs.sort();
     wavs
 }
+
+/// The 24 continuous hours of one day of real mains (`enf-reference` and `mains-day`), in
+/// time order.
+pub fn day_wavs() -> Vec<PathBuf> {
+    let mut paths: Vec<PathBuf> = ["enf-reference", "mains-day"]
+        .iter()
+        .flat_map(|sub| {
+            let dir = shared(sub).join(sub);
+            std::fs::read_dir(dir)
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .filter(|p| p.extension().is_some_and(|e| e == "wav"))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    paths.sort_by_key(|p| p.file_name().map(|n| n.to_owned()));
+    assert_eq!(paths.len(), 24, "the day's 24 hours");
+    paths
+}
