@@ -560,7 +560,8 @@ pub fn scan_phase(bb: &Baseband, params: &EditParams) -> Option<PhaseScan> {
 }
 
 /// The side a recording is tested at, in blocks, with its null model: of the sides whose
-/// stray was measured (and `longest` itself), the one whose smallest detectable jump, at the
+/// stray was measured (from `min_side` up, and `longest` itself), the one whose smallest
+/// detectable jump, at the
 /// recording's median precision there, is smallest. Each candidate is measured at a boundary
 /// every half side; the spread of its jumps, less their noise, is the recording's own stray.
 fn choose_side(
@@ -575,7 +576,8 @@ fn choose_side(
     let mut candidates: Vec<usize> = STRAY_TAILS
         .iter()
         .map(|t| (t.side_s / tb).round() as usize)
-        .filter(|&c| c < longest)
+        // a side never shorter than the shortest gap asked for (`min_gap_s`)
+        .filter(|&c| c < longest && c >= min_side)
         .collect();
     candidates.push(longest);
     let fits = |c: usize| 2 * c < n;
@@ -769,6 +771,13 @@ mod tests {
         // whole samples are removed: 5 of them, 12.5 ms, 225° of 50 Hz
         let truth = wrap(((0.0137f64 * fs).floor() / fs * 50.0 * 360.0).to_radians()).to_degrees();
         assert!((jump - truth).abs() < 25.0, "jump {jump} vs {truth}");
+        // the side is never shorter than the shortest gap asked for
+        let wide = EditParams {
+            min_gap_s: 5.0,
+            ..EditParams::default()
+        };
+        let side = scan_phase(&bb, &wide).unwrap().side_s;
+        assert!(side >= 5.0 - 1e-9, "side {side}");
         let clean = hum(120.0, fs, 0.02, None, 4);
         let scan = scan_phase(&baseband(&clean, fs, 50.0, &[1, 2, 3]), &p).unwrap();
         assert!(scan.jumps.is_empty(), "{:?}", scan.jumps);
