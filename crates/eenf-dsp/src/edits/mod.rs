@@ -252,12 +252,18 @@ impl Lines {
             })
             .collect();
         // the strongest line's residual phase, for the figure
+        // the line that stands highest over its own noise: its coherent power per second over
+        // its power per block (the total power of a line in broadband noise is mostly noise)
+        let standing = |z: &[Complex64]| -> f64 {
+            let coherent: f64 = z
+                .chunks(10)
+                .map(|c| c.iter().sum::<Complex64>().norm_sqr())
+                .sum();
+            let total: f64 = z.iter().map(|v| v.norm_sqr()).sum();
+            coherent / total.max(1e-300)
+        };
         let strongest = (0..turned.len())
-            .max_by(|&a, &b| {
-                let pa: f64 = turned[a].iter().map(|v| v.norm_sqr()).sum();
-                let pb: f64 = turned[b].iter().map(|v| v.norm_sqr()).sum();
-                pa.total_cmp(&pb)
-            })
+            .max_by(|&a, &b| standing(&turned[a]).total_cmp(&standing(&turned[b])))
             .unwrap_or(0);
         let phase_deg = residual_phase_deg(&turned[strongest], bb.multiples[strongest] as f64);
         Lines {
@@ -696,10 +702,24 @@ fn residual_phase_deg(z: &[Complex64], multiple: f64) -> Vec<f64> {
             z[lo..hi].iter().sum::<Complex64>()
         })
         .collect();
+    // where the line fades, its phase is noise and unwrapping it slips by whole turns of the
+    // line (360°/m of the fundamental), which would read as jumps the test does not see: left
+    // out (NaN) where the line stands under a third of its median
+    let mut mags: Vec<f64> = smooth.iter().map(|v| v.norm()).collect();
+    let median = if mags.is_empty() {
+        0.0
+    } else {
+        let mid = mags.len() / 2;
+        *mags.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
     let mut out = Vec::with_capacity(z.len());
     let mut prev = 0.0;
     let mut acc = 0.0;
     for v in &smooth {
+        if v.norm() < median / 3.0 {
+            out.push(f64::NAN);
+            continue;
+        }
         let a = v.arg();
         acc += wrap(a - prev);
         prev = a;
@@ -707,14 +727,17 @@ fn residual_phase_deg(z: &[Complex64], multiple: f64) -> Vec<f64> {
     }
     let half = 100usize;
     let mut sum = vec![0.0; out.len() + 1];
+    let mut count = vec![0usize; out.len() + 1];
     for (i, v) in out.iter().enumerate() {
-        sum[i + 1] = sum[i] + v;
+        let ok = v.is_finite();
+        sum[i + 1] = sum[i] + if ok { *v } else { 0.0 };
+        count[i + 1] = count[i] + ok as usize;
     }
     (0..out.len())
         .map(|i| {
             let lo = i.saturating_sub(half);
             let hi = (i + half).min(out.len());
-            out[i] - (sum[hi] - sum[lo]) / (hi - lo) as f64
+            out[i] - (sum[hi] - sum[lo]) / (count[hi] - count[lo]).max(1) as f64
         })
         .collect()
 }
