@@ -1034,7 +1034,7 @@ fn edits_chart<DB: DrawingBackend>(
             ),
             thinned(&s.time_s, &s.phase_deg),
             PALETTE[0],
-            "hum phase minus its 20 s running mean",
+            "lowest line's phase minus its 20 s mean (a splice turns every line)",
             None,
             false,
         )?;

@@ -173,8 +173,8 @@ pub struct PhaseScan {
     pub null: NullModel,
     /// The coarse ENF, Hz, one value per block.
     pub enf_hz: Vec<f64>,
-    /// The residual phase of the strongest line in degrees of the fundamental, one value per
-    /// block: what is left once the coarse ENF's phase is taken out.
+    /// The residual phase of the lowest line in degrees of the fundamental, one value per
+    /// block: what is left once the coarse ENF's phase is taken out (NaN where the line fades).
     pub phase_deg: Vec<f64>,
     /// The test at every boundary tested (after the edits found were taken into account).
     pub tests: Vec<BoundaryTest>,
@@ -218,7 +218,7 @@ struct Lines {
     block_s: f64,
     /// The coarse ENF, Hz off the grid, per block.
     coarse: Vec<f64>,
-    /// The strongest line's residual phase, degrees of the fundamental (for the figure).
+    /// The lowest line's residual phase, degrees of the fundamental (for the figure).
     phase_deg: Vec<f64>,
 }
 
@@ -251,21 +251,13 @@ impl Lines {
                     .collect()
             })
             .collect();
-        // the strongest line's residual phase, for the figure
-        // the line that stands highest over its own noise: its coherent power per second over
-        // its power per block (the total power of a line in broadband noise is mostly noise)
-        let standing = |z: &[Complex64]| -> f64 {
-            let coherent: f64 = z
-                .chunks(10)
-                .map(|c| c.iter().sum::<Complex64>().norm_sqr())
-                .sum();
-            let total: f64 = z.iter().map(|v| v.norm_sqr()).sum();
-            coherent / total.max(1e-300)
-        };
-        let strongest = (0..turned.len())
-            .max_by(|&a, &b| standing(&turned[a]).total_cmp(&standing(&turned[b])))
+        // the lowest line, the one the jumps are reported on: a harmonic's phase cannot show
+        // every jump (a half-turn of the fundamental is a whole turn at 2f0), and the line with
+        // the most power, noise and all, may be mostly noise whose phase slips by turns
+        let lowest = (0..bb.multiples.len())
+            .min_by_key(|&i| bb.multiples[i])
             .unwrap_or(0);
-        let phase_deg = residual_phase_deg(&turned[strongest], bb.multiples[strongest] as f64);
+        let phase_deg = residual_phase_deg(&turned[lowest], bb.multiples[lowest] as f64);
         Lines {
             null: NullModel::new(bb.multiples.len(), side_s, None),
             rate,
