@@ -12,6 +12,7 @@ mod common;
 
 use std::path::Path;
 
+use common::scale_clips;
 use eenf::audio::{AudioOptions, Sound};
 use eenf::edits::{sound_edits, EditParams, EditReport};
 use eenf_core::Nominal;
@@ -263,14 +264,6 @@ fn row(name: &str, level: f64, t: &Tally) -> String {
         t.false_alarms,
         t.hours
     )
-}
-
-fn scale_clips(n: usize) -> usize {
-    let k: f64 = std::env::var("EENF_EDITS_SCALE")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(1.0);
-    ((n as f64 * k).round() as usize).max(1)
 }
 
 #[test]

@@ -270,9 +270,7 @@ impl Lines {
             phase_deg,
         }
     }
-}
 
-impl Lines {
     /// Where within `tau ± reach` a step found at `tau` sits: the boundary that best splits
     /// `lo..hi` into two constant complex means once each line is turned by the slope both
     /// sides share (the change-in-mean estimator; the sliding test, whose free slopes absorb

@@ -47,3 +47,12 @@ pub fn day_wavs() -> Vec<PathBuf> {
     assert_eq!(paths.len(), 24, "the day's 24 hours");
     paths
 }
+
+/// `n` clips scaled by `EENF_EDITS_SCALE` (default 1), at least one.
+pub fn scale_clips(n: usize) -> usize {
+    let k: f64 = std::env::var("EENF_EDITS_SCALE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1.0);
+    ((n as f64 * k).round() as usize).max(1)
+}
