@@ -134,8 +134,22 @@ fn negative_numbers(cmd: clap::Command) -> clap::Command {
         .mut_subcommands(negative_numbers)
 }
 
-/// An error's text without the OS's error numbers (`(os error 2)`): the words say it.
+/// An error's text on one line (a cause that quotes a file's text may break lines), without
+/// the OS's error numbers (`(os error 2)`): the words say it.
 fn plain_words(text: &str) -> String {
+    // control characters (a damaged file's bytes quoted back) and line separators too
+    let breaks = |c: char| c.is_control() || c == '\u{2028}' || c == '\u{2029}';
+    let one_line;
+    let text = if text.contains(breaks) {
+        one_line = text
+            .split(|c: char| breaks(c) || c.is_whitespace())
+            .filter(|w| !w.is_empty())
+            .collect::<Vec<_>>()
+            .join(" ");
+        &one_line
+    } else {
+        text
+    };
     let mut out = String::with_capacity(text.len());
     let mut rest = text;
     while let Some(at) = rest.find(" (os error ") {
@@ -153,4 +167,18 @@ fn plain_words(text: &str) -> String {
     }
     out.push_str(rest);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::plain_words;
+
+    #[test]
+    fn errors_are_one_line_of_plain_words() {
+        assert_eq!(
+            plain_words("x.db3: damaged: CREATE TABLE t(\n  a\r\n) near \"\u{c}\" (os error 2)"),
+            "x.db3: damaged: CREATE TABLE t( a ) near \" \""
+        );
+        assert_eq!(plain_words("a  b (os error 13)"), "a  b");
+    }
 }

@@ -6,14 +6,21 @@
 //! Steps sit on a grid anchored at time 0 (for absolute times, the Unix epoch), so that two
 //! files of one archive fall on the same steps.
 
+/// Steps a page of [`StepAverager`] holds: a page is allocated when a sample first lands in
+/// it, so memory follows the steps that have samples, not the span between the first and last.
+const PAGE: i64 = 1 << 14;
+
+/// The sums and counts of the samples of a page's steps.
+type Page = (Box<[f64]>, Box<[u32]>);
+
 /// Accumulates samples `(time, value)` in any order into steps of `step` seconds.
 #[derive(Debug, Clone)]
 pub struct StepAverager {
     step: f64,
-    /// Index (time / step) of `sums[0]`.
-    first: i64,
-    sums: Vec<f64>,
-    counts: Vec<u32>,
+    /// Page number (step index / [`PAGE`]) → sums and counts of its steps.
+    pages: std::collections::BTreeMap<i64, Page>,
+    /// The first and last step indices with a sample.
+    span: Option<(i64, i64)>,
     max_steps: usize,
 }
 
@@ -35,9 +42,8 @@ impl StepAverager {
         assert!(step > 0.0 && step.is_finite(), "a positive step");
         StepAverager {
             step,
-            first: 0,
-            sums: Vec::new(),
-            counts: Vec::new(),
+            pages: Default::default(),
+            span: None,
             max_steps,
         }
     }
@@ -56,92 +62,108 @@ impl StepAverager {
     /// Adds a sample. A value that is not finite is ignored; `false` when its time lies so
     /// far from the others that the series would exceed its bound (it is not added).
     pub fn push(&mut self, time: f64, value: f64) -> bool {
-        if !time.is_finite() {
+        if !time.is_finite() || (time / self.step).abs() > 1e15 {
             return false;
         }
         if !value.is_finite() {
             return true;
         }
         let k = self.index(time);
-        if self.sums.is_empty() {
-            self.first = k;
-        }
-        if k < self.first {
-            let grow = (self.first - k) as u64;
-            if grow + self.sums.len() as u64 > self.max_steps as u64 {
-                return false;
-            }
-            // grow the front by at least what is there, so reversed input stays linear
-            let room = self.max_steps - self.sums.len();
-            let pad = (grow as usize).max(self.sums.len().min(room));
-            let mut sums = vec![0.0; pad];
-            sums.extend_from_slice(&self.sums);
-            let mut counts = vec![0; pad];
-            counts.extend_from_slice(&self.counts);
-            self.sums = sums;
-            self.counts = counts;
-            self.first -= pad as i64;
-        }
-        let i = (k - self.first) as u64;
-        if i >= self.max_steps as u64 {
+        let (lo, hi) = self.span.map_or((k, k), |(a, b)| (a.min(k), b.max(k)));
+        if (hi - lo) as u64 >= self.max_steps as u64 {
             return false;
         }
-        let i = i as usize;
-        if i >= self.sums.len() {
-            self.sums.resize(i + 1, 0.0);
-            self.counts.resize(i + 1, 0);
-        }
-        self.sums[i] += value;
-        self.counts[i] = self.counts[i].saturating_add(1);
+        self.span = Some((lo, hi));
+        let (sums, counts) = self.pages.entry(k.div_euclid(PAGE)).or_insert_with(|| {
+            (
+                vec![0.0; PAGE as usize].into_boxed_slice(),
+                vec![0; PAGE as usize].into_boxed_slice(),
+            )
+        });
+        let i = k.rem_euclid(PAGE) as usize;
+        sums[i] += value;
+        counts[i] = counts[i].saturating_add(1);
         true
     }
 
     /// Number of samples added.
     pub fn samples(&self) -> u64 {
-        self.counts.iter().map(|&c| c as u64).sum()
+        self.pages
+            .values()
+            .flat_map(|(_, c)| c.iter())
+            .map(|&c| c as u64)
+            .sum()
     }
 
     /// The series from the first step with a value to the last. Steps without a sample that
     /// lie between two with samples at most `interpolate_s` seconds apart are interpolated
     /// linearly (a series coarser than the step); other empty steps are gaps.
     pub fn finish(self, interpolate_s: f64) -> Steps {
-        let filled: Vec<usize> = (0..self.counts.len())
-            .filter(|&i| self.counts[i] > 0)
-            .collect();
-        let (Some(&a), Some(&b)) = (filled.first(), filled.last()) else {
-            return Steps {
+        let step = self.step;
+        self.finish_pieces(interpolate_s, u64::MAX)
+            .pop()
+            .unwrap_or(Steps {
                 start: 0.0,
-                step: self.step,
+                step,
                 values: Vec::new(),
-            };
-        };
-        let mut values: Vec<f64> = (a..=b)
-            .map(|i| {
-                if self.counts[i] > 0 {
-                    self.sums[i] / self.counts[i] as f64
-                } else {
-                    f64::NAN
-                }
             })
-            .collect();
-        let reach = (interpolate_s / self.step + 1e-9).floor() as usize;
-        if reach >= 2 {
-            for w in filled.windows(2) {
-                let (p, q) = (w[0] - a, w[1] - a);
-                if q - p >= 2 && q - p <= reach {
-                    let (vp, vq) = (values[p], values[q]);
-                    for (j, v) in values[p + 1..q].iter_mut().enumerate() {
-                        let f = (j + 1) as f64 / (q - p) as f64;
-                        *v = vp + (vq - vp) * f;
+    }
+
+    /// As [`StepAverager::finish`], but in pieces: a run of more than `max_gap` empty steps
+    /// ends one piece and the next sample starts another, so that a stray sample far from
+    /// the rest costs one value, not the span between.
+    pub fn finish_pieces(self, interpolate_s: f64, max_gap: u64) -> Vec<Steps> {
+        let reach = (interpolate_s / self.step + 1e-9).floor() as i64;
+        let step = self.step;
+        let mut pieces = Vec::new();
+        let mut cur: Option<(i64, Vec<f64>)> = None;
+        let mut last = i64::MIN;
+        for (page, (sums, counts)) in &self.pages {
+            for (i, (&sum, &count)) in sums.iter().zip(counts.iter()).enumerate() {
+                if count == 0 {
+                    continue;
+                }
+                let k = page * PAGE + i as i64;
+                let v = sum / count as f64;
+                let gap = if cur.is_some() {
+                    (k - last - 1) as u64
+                } else {
+                    0
+                };
+                match &mut cur {
+                    Some((_, values)) if gap <= max_gap => {
+                        let before = values.last().copied().unwrap_or(f64::NAN);
+                        let n = gap as usize;
+                        if n >= 1 && (n as i64) < reach {
+                            let q = (n + 1) as f64;
+                            values.extend((1..=n).map(|j| before + (v - before) * j as f64 / q));
+                        } else {
+                            values.resize(values.len() + n, f64::NAN);
+                        }
+                        values.push(v);
+                    }
+                    _ => {
+                        if let Some((first, values)) = cur.take() {
+                            pieces.push(Steps {
+                                start: first as f64 * step,
+                                step,
+                                values,
+                            });
+                        }
+                        cur = Some((k, vec![v]));
                     }
                 }
+                last = k;
             }
         }
-        Steps {
-            start: (self.first + a as i64) as f64 * self.step,
-            step: self.step,
-            values,
+        if let Some((first, values)) = cur {
+            pieces.push(Steps {
+                start: first as f64 * step,
+                step,
+                values,
+            });
         }
+        pieces
     }
 }
 

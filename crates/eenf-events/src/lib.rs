@@ -36,6 +36,7 @@ pub mod prophesee;
 pub mod rosbag;
 pub mod rosbag2;
 mod rosmsg;
+pub mod spool;
 mod stream;
 pub mod text;
 pub mod writers;

@@ -24,8 +24,10 @@ pub const MAGIC: &[u8] = b"#ROSBAG V2.0\n";
 const FORMAT: &str = "ROS 1 bag";
 /// The largest record header accepted.
 const MAX_HEADER: u32 = 1 << 20;
-/// The largest chunk accepted, expanded.
-pub const MAX_CHUNK: u64 = 1 << 30;
+/// The largest chunk (or other record) accepted, expanded: rosbag writes chunks of 768 KiB,
+/// larger only by one message, and a message of 64 MiB holds millions of events. It keeps a
+/// chunk, its expansion and its events under 200 MB.
+pub const MAX_CHUNK: u64 = 64 << 20;
 
 const OP_MSG_DATA: u8 = 0x02;
 const OP_BAG_HEADER: u8 = 0x03;
@@ -95,6 +97,12 @@ fn read_record(r: &mut dyn Read, left: u64, path: &Path, at: u64) -> Result<Opti
     read_exact(r, &mut header, path).map_err(|_| truncated("a record's header"))?;
     read_exact(r, &mut len, path).map_err(|_| truncated("a record's data length"))?;
     let dlen = u32::from_le_bytes(len) as u64;
+    if dlen > MAX_CHUNK {
+        return Err(corrupt(format!(
+            "a record of {dlen} bytes (eenf reads records up to {} MiB)",
+            MAX_CHUNK >> 20
+        )));
+    }
     if dlen + hlen as u64 + 8 > left {
         return Err(truncated(&format!(
             "a record announces {dlen} bytes of data, more than the file has left"
@@ -131,7 +139,10 @@ fn expand(rec: &Record, path: &Path, at: u64) -> Result<Vec<u8>> {
         reason,
     };
     if size > MAX_CHUNK {
-        return Err(corrupt(format!("a chunk of {size} bytes")));
+        return Err(corrupt(format!(
+            "a chunk of {size} bytes (eenf reads chunks up to {} MiB)",
+            MAX_CHUNK >> 20
+        )));
     }
     let mut out = Vec::new();
     let bound = size.max(1) + 1;

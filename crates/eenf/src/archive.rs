@@ -35,8 +35,18 @@ const SNIFF_ROWS: usize = 64;
 /// Farthest a value may lie from the nominal frequency, Hz: the grid's operating limits
 /// (47.5–52.5 Hz at 50 Hz); beyond them a row is a dropout or a fault of the meter.
 const PLAUSIBLE_HZ: f64 = 2.5;
-/// Longest span one input may cover (bounds the memory of its steps, 12 bytes each).
+/// Longest span one input may cover (its steps are allocated only where rows fall).
 const MAX_SPAN_S: f64 = 400.0 * 86_400.0;
+/// A gap longer than this splits the series into pieces: a stray row far from the rest costs
+/// one value, not the steps between.
+const PIECE_GAP_S: f64 = 6.0 * 3600.0;
+/// A piece shorter than this, beside a longer one, is a stray row (a mistyped date), dropped
+/// and counted with the rows far outside the file's span.
+const MIN_PIECE_S: f64 = 60.0;
+/// Rows in a row that bring no later time (repeats, rows going back, rows that are not a
+/// time and a frequency) after which the rest of a file is not read: no meter writes a
+/// million of them, and a compressed file can hold billions.
+const MAX_STALE_ROWS: u64 = 1_000_000;
 /// The coarsest step an archive may have, s.
 const MAX_STEP_S: f64 = 60.0;
 /// Years an archive's dates may name.
@@ -214,8 +224,9 @@ pub struct ArchiveOptions {
 /// An archive read onto regular steps.
 #[derive(Debug, Clone)]
 pub struct ArchiveImport {
-    /// The frequency, Hz, at Unix times `start + i·step` (NaN: a gap).
-    pub steps: Steps,
+    /// The frequency, Hz, at Unix times `start + i·step` (NaN: a gap), in time order; a new
+    /// piece starts after a gap of more than six hours.
+    pub steps: Vec<Steps>,
     /// The grid's nominal frequency, Hz.
     pub nominal_hz: f64,
     /// What was read, and what was dropped.
@@ -391,6 +402,12 @@ pub fn import(path: &Path, opts: &ArchiveOptions, step_s: Option<f64>) -> Result
         }
         let mut buf = Vec::new();
         loop {
+            if st.stale > MAX_STALE_ROWS {
+                report.warnings.push(format!(
+                    "{label}: {MAX_STALE_ROWS} rows in a row bring no later time; the rest of it is not read"
+                ));
+                break;
+            }
             buf.clear();
             match read_line(reader, &mut buf) {
                 Ok(0) => break,
@@ -434,13 +451,27 @@ pub fn import(path: &Path, opts: &ArchiveOptions, step_s: Option<f64>) -> Result
         });
     }
     let nominal = st.nominal;
+    let step = st.acc.step();
     let interpolate = if st.native > st.acc.step() * 1.01 {
         st.native * 1.5
     } else {
         0.0
     };
+    let mut pieces = st
+        .acc
+        .finish_pieces(interpolate, (PIECE_GAP_S / step).ceil() as u64);
+    let min_len = (MIN_PIECE_S / step).ceil() as usize;
+    if pieces.iter().any(|p| p.values.len() >= min_len) {
+        pieces.retain(|p| {
+            let keep = p.values.len() >= min_len;
+            if !keep {
+                report.far += p.values.iter().filter(|v| v.is_finite()).count() as u64;
+            }
+            keep
+        });
+    }
     Ok(ArchiveImport {
-        steps: st.acc.finish(interpolate),
+        steps: pieces,
         nominal_hz: nominal,
         report,
     })
@@ -1316,6 +1347,9 @@ struct ImportState {
     native: f64,
     acc: StepAverager,
     last: f64,
+    /// The latest instant read, and the rows since that brought no later one.
+    latest: f64,
+    stale: u64,
     /// Offsets of whole 15-minute stretches of wall-clock time (no change inside).
     cache: Option<(i64, f64)>,
     clock_notes: std::collections::BTreeMap<ClockNote, u64>,
@@ -1328,6 +1362,8 @@ impl ImportState {
             native,
             acc: StepAverager::new(step, (MAX_SPAN_S / step) as usize),
             last: f64::NEG_INFINITY,
+            latest: f64::NEG_INFINITY,
+            stale: 0,
             cache: None,
             clock_notes: Default::default(),
         }
@@ -1396,6 +1432,7 @@ impl ImportState {
             return;
         }
         report.rows += 1;
+        self.stale += 1;
         let mut fields: [&[u8]; 16] = [&[]; 16];
         let mut n = 0;
         for f in layout.split(line) {
@@ -1436,6 +1473,10 @@ impl ImportState {
             report.repeated += 1;
         }
         self.last = instant;
+        if instant > self.latest {
+            self.latest = instant;
+            self.stale = 0;
+        }
         let hz = layout.unit.to_hz(v, self.nominal);
         if (hz - self.nominal).abs().is_nan() || (hz - self.nominal).abs() > PLAUSIBLE_HZ {
             report.implausible += 1;
@@ -1602,9 +1643,10 @@ mod tests {
             (52, 1, 1, 1),
             "{r:?}"
         );
-        assert_eq!(imp.steps.start, t("2014-12-31T22:00:00Z"));
-        assert_eq!(imp.steps.step, 1.0);
-        let v = &imp.steps.values;
+        assert_eq!(imp.steps.len(), 1);
+        assert_eq!(imp.steps[0].start, t("2014-12-31T22:00:00Z"));
+        assert_eq!(imp.steps[0].step, 1.0);
+        let v = &imp.steps[0].values;
         // steps are centred on whole seconds: the last holds 4.5–4.9 s
         assert_eq!(v.len(), 6);
         for (k, x) in v.iter().enumerate().skip(1).take(4) {
@@ -1648,17 +1690,62 @@ mod tests {
         assert_eq!((r.missing_times, r.second_passage), (0, 3600), "{r:?}");
         assert_eq!(r.clock_changes.len(), 1, "{:?}", r.clock_changes);
         // every UTC second of both stretches holds its own value: no hour lost or doubled
-        let s = &imp.steps;
+        // the two stretches, seven months apart, are two pieces
+        assert_eq!(imp.steps.len(), 2);
         for &u in &truth {
+            let s = imp.steps.iter().rfind(|s| s.start <= u).unwrap();
             let i = ((u - s.start) / s.step).round() as usize;
             assert!((s.values[i] - f(u)).abs() < 1e-4, "{}", crate::time::utc(u));
         }
-        let filled = s.values.iter().filter(|v| v.is_finite()).count();
+        let filled: usize = imp
+            .steps
+            .iter()
+            .map(|s| s.values.iter().filter(|v| v.is_finite()).count())
+            .sum();
         assert_eq!(filled, truth.len());
         // a time inside the hour skipped in spring is dropped and counted
         let text = "time,frequency\n2024-03-31 01:59:59,50.0\n2024-03-31 02:30:00,50.0\n2024-03-31 03:00:00,50.0\n";
         let imp = import_onto(text, &opts, Some(1.0)).unwrap();
         assert_eq!(imp.report.missing_times, 1);
-        assert_eq!(imp.steps.values.len(), 2);
+        assert_eq!(imp.steps[0].values.len(), 2);
+    }
+
+    #[test]
+    fn a_stray_row_far_away_is_a_piece_and_endless_repeats_end() {
+        let utc = ArchiveOptions {
+            zone: Some(Zone::utc()),
+            ..Default::default()
+        };
+        // one row 399 days after an hour of rows: two pieces, not 399 days of steps
+        let mut text = String::from("time,frequency\n");
+        for i in 0..3600 {
+            text += &format!("2023-01-01 00:{:02}:{:02},50.01\n", i / 60, i % 60);
+        }
+        text += "2024-02-04 00:00:00,50.02\n";
+        let imp = import_onto(&text, &utc, Some(1.0)).unwrap();
+        let lens: Vec<usize> = imp.steps.iter().map(|s| s.values.len()).collect();
+        assert_eq!(lens, vec![3600], "the stray row is dropped");
+        assert_eq!(imp.report.far, 1);
+        // a second hour months away is a piece of its own
+        for i in 0..3600 {
+            text += &format!("2023-06-05 00:{:02}:{:02},50.02\n", i / 60, i % 60);
+        }
+        let imp = import_onto(&text, &utc, Some(1.0)).unwrap();
+        let lens: Vec<usize> = imp.steps.iter().map(|s| s.values.len()).collect();
+        assert_eq!(lens, vec![3600, 3600]);
+        // a row repeated past the bound: the rest is not read, and the reading says so
+        let mut text = String::from("time,frequency\n2023-01-01 00:00:00,50.0\n");
+        text += &"2023-01-01 00:00:01,50.0\n".repeat(MAX_STALE_ROWS as usize + 10);
+        text += "2023-01-01 00:00:02,50.0\n";
+        let imp = import_onto(&text, &utc, Some(1.0)).unwrap();
+        assert_eq!(imp.steps[0].values.len(), 2);
+        assert!(
+            imp.report
+                .warnings
+                .iter()
+                .any(|w| w.contains("bring no later time")),
+            "{:?}",
+            imp.report.warnings
+        );
     }
 }

@@ -318,6 +318,7 @@ fn read_symphonia(
     opts: &AudioOptions,
 ) -> std::result::Result<Audio, Unreadable> {
     let other = |e: anyhow::Error| Unreadable::Other(anyhow!("{}: {e}", path.display()));
+    let file = crate::flac_mask::flac_masked(file).map_err(|why| other(anyhow!(why)))?;
     let mss = MediaSourceStream::new(Box::new(file), Default::default());
     let mut hint = Hint::new();
     if let Some(ext) = path.extension().and_then(|e| e.to_str()) {

@@ -350,15 +350,21 @@ impl ReferenceSeries {
             let imp = crate::archive::import(path, &opts, None)?;
             let mut notes = vec![format!("{}: {}", path.display(), imp.report)];
             notes.extend(imp.report.warnings.iter().cloned());
-            return Ok(vec![ReferenceSeries {
-                notes,
-                name: path.display().to_string(),
-                start: imp.steps.start,
-                absolute: true,
-                zone: zone.cloned(),
-                step: imp.steps.step,
-                values: SeriesValues::Hz(imp.steps.values),
-            }]);
+            // pieces far apart are stored apart; the notes go with the first
+            return Ok(imp
+                .steps
+                .into_iter()
+                .enumerate()
+                .map(|(i, piece)| ReferenceSeries {
+                    notes: if i == 0 { notes.clone() } else { Vec::new() },
+                    name: path.display().to_string(),
+                    start: piece.start,
+                    absolute: true,
+                    zone: zone.cloned(),
+                    step: piece.step,
+                    values: SeriesValues::Hz(piece.values),
+                })
+                .collect());
         }
         let (start, absolute, step, hz) = if let ReferenceSource::Wav(_) = source {
             let trace = reference_file(path, Nominal::Hz(nominal), &EnfParams::default())?;
@@ -470,14 +476,15 @@ pub fn build_store(
     let mut next_start = build.start;
     let mut archives = Vec::new();
     for (path, at, archive) in &files {
-        let (start, step, values, f0) = if is_wav(path) {
+        // an archive's pieces (far apart in time) are merged one by one
+        let (pieces, f0) = if is_wav(path) {
             let trace = reference_file(path, Nominal::Auto, &EnfParams::default())?;
             let start = match at {
                 Some(t) => *t,
                 None => wav_start(path, build.zone.as_ref())?,
             };
             let f0 = nominal_of(&trace, path)?;
-            (start, trace.step_s, trace.enf_hz, f0)
+            (vec![(start, trace.step_s, trace.enf_hz)], f0)
         } else if *archive {
             let opts = ArchiveOptions {
                 zone: build.zone.clone(),
@@ -489,7 +496,8 @@ pub fn build_store(
                 report,
             } = crate::archive::import(path, &opts, None)?;
             archives.push((path.clone(), report));
-            (steps.start, steps.step, steps.values, nominal_hz)
+            let pieces = steps.into_iter().map(|p| (p.start, p.step, p.values));
+            (pieces.collect(), nominal_hz)
         } else {
             let trace = read_series(path, build.index_step_s)?;
             let start = at.or(next_start).with_context(|| {
@@ -499,10 +507,15 @@ pub fn build_store(
                 )
             })?;
             let f0 = nominal_of(&trace, path)?;
-            (start, trace.step_s, trace.enf_hz, f0)
+            (vec![(start, trace.step_s, trace.enf_hz)], f0)
         };
-        let values = &values;
-        next_start = Some(start + values.len() as f64 * step);
+        let Some((first_start, step, _)) = pieces.first() else {
+            continue;
+        };
+        let (start, step) = (*first_start, *step);
+        if let Some((last_start, last_step, last)) = pieces.last() {
+            next_start = Some(last_start + last.len() as f64 * last_step);
+        }
         let grid = build
             .grid
             .clone()
@@ -527,7 +540,9 @@ pub fn build_store(
                 s.meta.nominal_hz
             );
         }
-        s.merge(start, step, values)?;
+        for (start, step, values) in &pieces {
+            s.merge(*start, *step, values)?;
+        }
         bar.inc(1);
     }
     bar.finish_and_clear();

@@ -11,8 +11,9 @@ pub const ZSTD: u16 = 32015;
 pub const BLOSC: u16 = 32001;
 /// Prophesee's ECF (0x8ECF).
 pub const ECF: u16 = 0x8ECF;
-/// The largest chunk a filter may expand to when its parameters do not say.
-pub const MAX_CHUNK: usize = 256 << 20;
+/// The largest chunk eenf decodes: 16 times the 1 MiB h5py chunks at most, and small enough
+/// that the chunks of a slice, decoded on all cores, keep the process well under 200 MB.
+pub const MAX_CHUNK: usize = 16 << 20;
 
 fn err(what: &str, reason: impl std::fmt::Display) -> hdf5_reader::error::Error {
     hdf5_reader::error::Error::InvalidData(format!("a {what} chunk that does not expand: {reason}"))
@@ -37,7 +38,10 @@ fn zstd_chunk(data: &[u8]) -> hdf5_reader::error::Result<Vec<u8>> {
         .and_then(|d| d.take(MAX_CHUNK as u64 + 1).read_to_end(&mut out))
         .map_err(|e| err("zstd", e))?;
     if out.len() > MAX_CHUNK {
-        return Err(err("zstd", "it expands past 256 MiB"));
+        return Err(err(
+            "zstd",
+            format!("it expands past {} MiB", MAX_CHUNK >> 20),
+        ));
     }
     Ok(out)
 }

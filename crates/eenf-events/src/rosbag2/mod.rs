@@ -24,7 +24,11 @@ use mcap::sans_io::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
 use crate::error::{io_err, EventError, Result};
 use crate::held::Held;
 use crate::rosmsg::{kind_of, MessageDecoder, Serialization, TYPES};
+use crate::spool::NamedCopy;
+
+mod folder;
 use crate::{EventBatch, EventReader, Source, StreamDesc, StreamInfo};
+pub use folder::{is_folder, storage_files};
 
 /// The first bytes of an SQLite database.
 pub const SQLITE_MAGIC: &[u8] = b"SQLite format 3\0";
@@ -34,79 +38,30 @@ pub const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
 const ZSTD_MAGIC: &[u8] = &[0x28, 0xB5, 0x2F, 0xFD];
 const SQLITE: &str = "rosbag2 (SQLite)";
 const MCAP: &str = "rosbag2 (MCAP)";
-/// The largest message (or MCAP record) accepted, expanded.
-pub const MAX_MESSAGE: usize = 1 << 30;
+/// The largest message accepted, expanded: 16 MiB holds a million events in the roomiest
+/// encoding (dvs_msgs, 16 bytes an event), more than a camera driver publishes at once, and
+/// keeps the messages in flight, their expansion and their events under 200 MB.
+pub const MAX_MESSAGE: usize = 16 << 20;
+/// The largest MCAP record (a chunk, compressed or not, or a record inside one).
+pub const MAX_RECORD: usize = 2 * MAX_MESSAGE;
+/// The size an SQLite database's header states (page size × page count, when the count is
+/// valid: <https://www.sqlite.org/fileformat.html#in_header_database_size>).
+fn sqlite_size(head: &[u8]) -> Option<u64> {
+    let be32 = |at: usize| -> Option<u32> {
+        Some(u32::from_be_bytes(head.get(at..at + 4)?.try_into().ok()?))
+    };
+    let page = match u16::from_be_bytes(head.get(16..18)?.try_into().ok()?) {
+        1 => 65536,
+        p => u64::from(p),
+    };
+    let (pages, change, valid_for) = (be32(28)?, be32(24)?, be32(92)?);
+    (pages > 0 && change == valid_for).then(|| page * u64::from(pages))
+}
+
+/// Bytes of messages fetched from SQLite at a time, at most (and one message).
+const PAGE_BYTES: usize = 4 << 20;
 /// Messages fetched from SQLite at a time.
 const PAGE: usize = 256;
-
-/// True when `dir` looks like a rosbag2 folder: it holds a storage file or `metadata.yaml`.
-pub fn is_folder(dir: &Path) -> bool {
-    dir.join("metadata.yaml").is_file() || storage_files(dir).is_ok_and(|f| !f.is_empty())
-}
-
-/// The storage files of the rosbag2 folder `dir`, in the order the metadata lists them, else
-/// by name.
-pub fn storage_files(dir: &Path) -> Result<Vec<PathBuf>> {
-    let io = |e| io_err(dir, e);
-    if let Ok(yaml) = std::fs::read_to_string(dir.join("metadata.yaml")) {
-        let listed = listed_files(&yaml);
-        if !listed.is_empty() {
-            return Ok(listed.iter().map(|f| dir.join(f)).collect());
-        }
-    }
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(io)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
-            let name = name.strip_suffix(".zstd").unwrap_or(name);
-            p.is_file() && (name.ends_with(".db3") || name.ends_with(".mcap"))
-        })
-        .collect();
-    // split bags number their files: name_0, name_1, … name_10 in numeric order
-    files.sort_by_key(|p| {
-        let stem = p
-            .file_name()
-            .and_then(|n| n.to_str())
-            .unwrap_or("")
-            .to_string();
-        let digits: String = stem
-            .split('.')
-            .next()
-            .unwrap_or("")
-            .rsplit('_')
-            .next()
-            .unwrap_or("")
-            .chars()
-            .filter(char::is_ascii_digit)
-            .collect();
-        (digits.parse::<u64>().unwrap_or(0), stem)
-    });
-    Ok(files)
-}
-
-/// The items of `relative_file_paths:` in a rosbag2 `metadata.yaml`.
-fn listed_files(yaml: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut lines = yaml
-        .lines()
-        .skip_while(|l| l.trim() != "relative_file_paths:");
-    let Some(key) = lines.next() else {
-        return out;
-    };
-    let indent = key.len() - key.trim_start().len();
-    for l in lines {
-        let t = l.trim_start();
-        let this = l.len() - t.len();
-        match t.strip_prefix("- ") {
-            Some(item) if this >= indent => {
-                out.push(item.trim().trim_matches(['"', '\'']).to_string())
-            }
-            _ => break,
-        }
-    }
-    out
-}
 
 /// A topic of a bag.
 #[derive(Debug, Clone)]
@@ -128,23 +83,24 @@ enum Storage {
 /// An SQLite storage file.
 struct SqliteFile {
     db: rusqlite::Connection,
-    /// Keeps a copy of what could not be opened by name (stdin, a `.zstd` file) alive.
-    _copy: Option<tempfile::TempPath>,
+    /// Keeps a copy of what could not be opened by name (stdin, a `.db3.zstd`) alive.
+    _copy: Option<NamedCopy>,
     topic: Option<i64>,
     entry: Option<Topic>,
     last_id: i64,
-    page: VecDeque<Vec<u8>>,
+    /// Messages fetched and not yet handed on (one too large is its reason).
+    page: VecDeque<Message>,
     ended: bool,
 }
 
 /// An MCAP storage file.
 struct McapFile {
-    src: Box<dyn Source>,
+    /// The file, or the stream a `.mcap.zstd` expands to (read as it expands).
+    src: Box<dyn Read + Send>,
     reader: LinearReader,
     /// Channel id → topic; schema id → type name.
     channels: HashMap<u16, Topic>,
     schemas: HashMap<u16, String>,
-    _copy: Option<tempfile::TempPath>,
 }
 
 /// Messages of the chosen topic, and what the choice needs to know.
@@ -277,21 +233,8 @@ impl Rosbag2Reader {
         let n = read_full(&mut src, &mut head).map_err(io)?;
         src.seek(SeekFrom::Start(0)).map_err(io)?;
         let head = &head[..n];
-        let mut copy = None;
         if head.starts_with(ZSTD_MAGIC) {
-            // a file compressed whole: expanded beside the other temporary files
-            let mut tmp = tempfile::NamedTempFile::new().map_err(io)?;
-            let mut z = zstd::stream::read::Decoder::new(src).map_err(io)?;
-            std::io::copy(&mut z, tmp.as_file_mut()).map_err(|e| EventError::Damaged {
-                path: file.clone(),
-                format: "rosbag2 (zstd file)",
-                reason: format!("it does not expand: {e}"),
-            })?;
-            let mut f = tmp.reopen().map_err(io)?;
-            f.seek(SeekFrom::Start(0)).map_err(io)?;
-            copy = Some(tmp.into_temp_path());
-            src = Box::new(f);
-            return self.open_storage(&file, src, copy);
+            return self.open_zstd(&file, src);
         }
         if !head.starts_with(SQLITE_MAGIC) && !head.starts_with(MCAP_MAGIC) {
             return Err(EventError::UnknownFormat {
@@ -300,47 +243,80 @@ impl Rosbag2Reader {
                 supported: crate::SUPPORTED,
             });
         }
-        if head.starts_with(SQLITE_MAGIC) && !std::fs::metadata(&file).is_ok_and(|m| m.is_file()) {
-            // SQLite opens files by name: a pipe's content goes to a named temporary file
-            let mut tmp = tempfile::NamedTempFile::new().map_err(io)?;
-            std::io::copy(&mut src, tmp.as_file_mut()).map_err(io)?;
-            copy = Some(tmp.into_temp_path());
+        if head.starts_with(MCAP_MAGIC) {
+            let channels = mcap_summary(&mut src);
+            return self.open_mcap(Box::new(src), channels);
         }
-        self.open_storage(&file, src, copy)
+        let mut copy = None;
+        if !std::fs::metadata(&file).is_ok_and(|m| m.is_file()) {
+            // SQLite opens files by name: a pipe's content goes to a named temporary file
+            let (c, f) = crate::spool::spool(&[], &mut src, None).map_err(io)?;
+            copy = Some(c);
+            src = Box::new(f);
+        }
+        drop(src);
+        self.open_sqlite(&file, copy)
     }
 
-    fn open_storage(
-        &mut self,
-        file: &Path,
-        mut src: Box<dyn Source>,
-        copy: Option<tempfile::TempPath>,
-    ) -> Result<bool> {
-        let io = |e| io_err(file, e);
-        let mut head = [0u8; 16];
-        let n = read_full(&mut src, &mut head).map_err(io)?;
-        src.seek(SeekFrom::Start(0)).map_err(io)?;
-        if head[..n].starts_with(MCAP_MAGIC) {
-            self.format = MCAP;
-            let mut m = McapFile {
-                src,
-                reader: LinearReader::new_with_options(
-                    LinearReaderOptions::default().with_record_length_limit(MAX_MESSAGE),
-                ),
-                channels: HashMap::new(),
-                schemas: HashMap::new(),
-                _copy: copy,
-            };
-            m.read_summary();
-            self.storage = Some(Storage::Mcap(m));
-            return Ok(true);
-        }
-        self.format = SQLITE;
-        let name: &Path = copy.as_deref().unwrap_or(file);
-        let damaged = |e: rusqlite::Error| EventError::Damaged {
+    /// A storage file compressed whole (rosbag2's zstd file mode), its content checked as soon
+    /// as its first bytes expand: an MCAP is read as it expands; an SQLite database (which
+    /// opens files by name) is expanded to a temporary file, no larger than its header states.
+    fn open_zstd(&mut self, file: &Path, mut src: Box<dyn Source>) -> Result<bool> {
+        let damaged = |e: std::io::Error| EventError::Damaged {
             path: file.to_path_buf(),
-            format: SQLITE,
-            reason: e.to_string(),
+            format: "rosbag2 (zstd file)",
+            reason: format!("it does not expand: {e}"),
         };
+        let compressed = src.seek(SeekFrom::End(0)).map_err(|e| io_err(file, e))?;
+        src.seek(SeekFrom::Start(0)).map_err(|e| io_err(file, e))?;
+        let z = zstd::stream::read::Decoder::new(src).map_err(|e| io_err(file, e))?;
+        let mut z = crate::spool::Bounded::new(
+            z,
+            crate::spool::expansion_bound(compressed),
+            "a hundred times its compressed size and 64 MiB: not event data",
+        );
+        let mut head = [0u8; 100];
+        let n = read_full(&mut z, &mut head).map_err(damaged)?;
+        let head = &head[..n];
+        if head.starts_with(MCAP_MAGIC) {
+            let whole = std::io::Cursor::new(head.to_vec()).chain(z);
+            return self.open_mcap(Box::new(whole), HashMap::new());
+        }
+        if !head.starts_with(SQLITE_MAGIC) {
+            return Err(EventError::UnknownFormat {
+                path: file.to_path_buf(),
+                reason: "a zstd file that holds neither an SQLite nor an MCAP rosbag2".into(),
+                supported: crate::SUPPORTED,
+            });
+        }
+        let (copy, _) = crate::spool::spool(head, &mut z, sqlite_size(head)).map_err(damaged)?;
+        self.open_sqlite(file, Some(copy))
+    }
+
+    /// An MCAP storage file: its summary read first when it can be (a file, not a stream).
+    fn open_mcap(
+        &mut self,
+        src: Box<dyn Read + Send>,
+        channels: HashMap<u16, Topic>,
+    ) -> Result<bool> {
+        self.format = MCAP;
+        self.storage = Some(Storage::Mcap(McapFile {
+            src,
+            reader: LinearReader::new_with_options(
+                LinearReaderOptions::default().with_record_length_limit(MAX_RECORD),
+            ),
+            channels,
+            schemas: HashMap::new(),
+        }));
+        Ok(true)
+    }
+
+    /// An SQLite storage file, by name (`copy`'s, when it is a copy).
+    fn open_sqlite(&mut self, file: &Path, copy: Option<NamedCopy>) -> Result<bool> {
+        let io = |e| io_err(file, e);
+        self.format = SQLITE;
+        let name: &Path = copy.as_ref().map_or(file, NamedCopy::path);
+        let damaged = |e: rusqlite::Error| sqlite_damage(file, e);
         // immutable: read-only folders open, and nothing (a journal, a lock) is written
         let uri = format!(
             "file:{}?immutable=1",
@@ -464,7 +440,7 @@ impl Rosbag2Reader {
 
     /// The next message of the chosen topic, across the storage files (expanded, or why it
     /// could not be); `None` at the end.
-    fn next_message(&mut self) -> Result<Option<std::result::Result<Vec<u8>, String>>> {
+    fn next_message(&mut self) -> Result<Option<Message>> {
         loop {
             if self.feed.is_none() {
                 let Some(storage) = self.storage.take() else {
@@ -595,7 +571,9 @@ impl EventReader for Rosbag2Reader {
 /// What the thread reading a storage file hands on: a message's topic and its bytes
 /// (expanded, or why they could not be), `None` at the end of the file, or the damage that
 /// ended it.
-type Fed = Result<Option<(Topic, std::result::Result<Vec<u8>, String>)>>;
+/// A message's bytes, or why it cannot be read (the message is skipped, the bag goes on).
+type Message = std::result::Result<Vec<u8>, String>;
+type Fed = Result<Option<(Topic, Message)>>;
 
 /// Batches in flight between the thread reading a file and the decoder.
 const IN_FLIGHT: usize = 4;
@@ -618,9 +596,11 @@ fn feed(storage: Storage, file: PathBuf, chosen: Arc<OnceLock<String>>) -> Recei
             while !end && bytes < BATCH_BYTES && batch.len() < BATCH_MESSAGES {
                 let item = match &mut storage {
                     Storage::Sqlite(s) => s.next_of(chosen.get(), &file),
-                    Storage::Mcap(m) => m.next_of(chosen.get(), &file),
+                    Storage::Mcap(m) => m
+                        .next_of(chosen.get(), &file)
+                        .map(|m| m.map(|(t, data)| (t, Ok(data)))),
                 };
-                let item = item.map(|m| m.map(|(t, data)| (t, expand_message(data))));
+                let item = item.map(|m| m.map(|(t, data)| (t, data.and_then(expand_message))));
                 match &item {
                     Ok(Some((_, Ok(data)))) => bytes += data.len(),
                     Ok(Some(_)) => {}
@@ -637,8 +617,77 @@ fn feed(storage: Storage, file: PathBuf, chosen: Arc<OnceLock<String>>) -> Recei
     rx
 }
 
+/// The channels an MCAP file's summary names (none when it has no summary), `src` left at
+/// its start.
+fn mcap_summary(src: &mut dyn Source) -> HashMap<u16, Topic> {
+    let mut channels = HashMap::new();
+    let Ok(len) = src.seek(SeekFrom::End(0)) else {
+        return channels;
+    };
+    let mut s = SummaryReader::new_with_options(
+        SummaryReaderOptions::default()
+            .with_file_size(len)
+            .with_record_length_limit(MAX_RECORD),
+    );
+    let mut ok = true;
+    while let Some(event) = s.next_event() {
+        match event {
+            Ok(SummaryReadEvent::ReadRequest(n)) => match src.read(s.insert(n)) {
+                Ok(k) => s.notify_read(k),
+                Err(_) => {
+                    ok = false;
+                    break;
+                }
+            },
+            Ok(SummaryReadEvent::SeekRequest(to)) => match src.seek(to) {
+                Ok(pos) => s.notify_seeked(pos),
+                Err(_) => {
+                    ok = false;
+                    break;
+                }
+            },
+            Err(_) => {
+                ok = false;
+                break;
+            }
+        }
+    }
+    if src.seek(SeekFrom::Start(0)).is_err() {
+        return channels;
+    }
+    let summary = if ok { s.finish() } else { None };
+    let Some(summary) = summary else {
+        return channels;
+    };
+    let counts = summary
+        .stats
+        .as_ref()
+        .map(|s| s.channel_message_counts.clone())
+        .unwrap_or_default();
+    for (id, c) in &summary.channels {
+        channels.insert(
+            *id,
+            Topic {
+                id: *id as i64,
+                name: c.topic.clone(),
+                msg_type: c
+                    .schema
+                    .as_ref()
+                    .map(|s| s.name.clone())
+                    .unwrap_or_default(),
+                serialization: c.message_encoding.clone(),
+                count: summary
+                    .stats
+                    .as_ref()
+                    .map(|_| counts.get(id).copied().unwrap_or(0)),
+            },
+        );
+    }
+    channels
+}
+
 /// A message compressed on its own (rosbag2's message compression mode), expanded.
-fn expand_message(msg: Vec<u8>) -> std::result::Result<Vec<u8>, String> {
+fn expand_message(msg: Vec<u8>) -> Message {
     if !msg.starts_with(ZSTD_MAGIC) {
         return Ok(msg);
     }
@@ -656,7 +705,12 @@ fn sqlite_damage(file: &Path, e: rusqlite::Error) -> EventError {
     EventError::Damaged {
         path: file.to_path_buf(),
         format: SQLITE,
-        reason: e.to_string(),
+        // SQLite quotes a damaged schema's statements whole, line breaks and all
+        reason: e
+            .to_string()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" "),
     }
 }
 
@@ -715,11 +769,7 @@ impl SqliteFile {
     }
 
     /// The next message of the topic named `chosen` (resolved on the first call).
-    fn next_of(
-        &mut self,
-        chosen: Option<&String>,
-        file: &Path,
-    ) -> Result<Option<(Topic, Vec<u8>)>> {
+    fn next_of(&mut self, chosen: Option<&String>, file: &Path) -> Fed {
         if self.topic.is_none() && !self.ended {
             let topic = self
                 .topics()
@@ -740,96 +790,51 @@ impl SqliteFile {
             .map(|m| (entry, m)))
     }
 
-    /// The next message of the topic, in the order they were written.
-    fn next(&mut self) -> rusqlite::Result<Option<Vec<u8>>> {
+    /// The next message of the topic, in the order they were written. A message's length is
+    /// read before its bytes: one past [`MAX_MESSAGE`] is never fetched, and a page ends
+    /// past [`PAGE_BYTES`].
+    fn next(&mut self) -> rusqlite::Result<Option<Message>> {
         if self.page.is_empty() && !self.ended {
             let Some(topic) = self.topic else {
                 return Ok(None);
             };
             let mut q = self.db.prepare_cached(
-                "SELECT id, data FROM messages WHERE topic_id = ?1 AND id > ?2 ORDER BY id LIMIT ?3",
+                "SELECT id, length(data), CASE WHEN length(data) <= ?4 THEN data END \
+                 FROM messages WHERE topic_id = ?1 AND id > ?2 ORDER BY id LIMIT ?3",
             )?;
-            let rows = q.query_map(rusqlite::params![topic, self.last_id, PAGE as i64], |r| {
-                Ok((r.get::<_, i64>(0)?, r.get::<_, Vec<u8>>(1)?))
-            })?;
-            for row in rows {
-                let (id, data) = row?;
+            let mut rows = q.query(rusqlite::params![
+                topic,
+                self.last_id,
+                PAGE as i64,
+                MAX_MESSAGE as i64
+            ])?;
+            let (mut n, mut bytes) = (0, 0);
+            while let Some(r) = rows.next()? {
+                let (id, len) = (r.get::<_, i64>(0)?, r.get::<_, Option<i64>>(1)?);
                 self.last_id = id;
+                n += 1;
+                let data = match r.get::<_, Option<Vec<u8>>>(2)? {
+                    Some(d) => Ok(d),
+                    None if len.is_none() => Ok(Vec::new()),
+                    None => Err(format!(
+                        "a message of {} bytes (eenf reads messages up to {} MiB)",
+                        len.unwrap_or(0),
+                        MAX_MESSAGE >> 20
+                    )),
+                };
+                bytes += data.as_ref().map_or(0, Vec::len);
                 self.page.push_back(data);
+                if bytes > PAGE_BYTES {
+                    break;
+                }
             }
-            self.ended = self.page.len() < PAGE;
+            self.ended = n < PAGE && bytes <= PAGE_BYTES;
         }
         Ok(self.page.pop_front())
     }
 }
 
 impl McapFile {
-    /// Reads the summary at the end of the file, when it has one: its channels and counts.
-    fn read_summary(&mut self) {
-        let Ok(len) = self.src.seek(SeekFrom::End(0)) else {
-            return;
-        };
-        let mut s = SummaryReader::new_with_options(
-            SummaryReaderOptions::default()
-                .with_file_size(len)
-                .with_record_length_limit(MAX_MESSAGE),
-        );
-        let mut ok = true;
-        while let Some(event) = s.next_event() {
-            match event {
-                Ok(SummaryReadEvent::ReadRequest(n)) => match self.src.read(s.insert(n)) {
-                    Ok(k) => s.notify_read(k),
-                    Err(_) => {
-                        ok = false;
-                        break;
-                    }
-                },
-                Ok(SummaryReadEvent::SeekRequest(to)) => match self.src.seek(to) {
-                    Ok(pos) => s.notify_seeked(pos),
-                    Err(_) => {
-                        ok = false;
-                        break;
-                    }
-                },
-                Err(_) => {
-                    ok = false;
-                    break;
-                }
-            }
-        }
-        if self.src.seek(SeekFrom::Start(0)).is_err() {
-            return;
-        }
-        let summary = if ok { s.finish() } else { None };
-        let Some(summary) = summary else {
-            return;
-        };
-        let counts = summary
-            .stats
-            .as_ref()
-            .map(|s| s.channel_message_counts.clone())
-            .unwrap_or_default();
-        for (id, c) in &summary.channels {
-            self.channels.insert(
-                *id,
-                Topic {
-                    id: *id as i64,
-                    name: c.topic.clone(),
-                    msg_type: c
-                        .schema
-                        .as_ref()
-                        .map(|s| s.name.clone())
-                        .unwrap_or_default(),
-                    serialization: c.message_encoding.clone(),
-                    count: summary
-                        .stats
-                        .as_ref()
-                        .map(|_| counts.get(id).copied().unwrap_or(0)),
-                },
-            );
-        }
-    }
-
     /// The next message of the channel of topic `chosen`, or of any channel: its topic and
     /// bytes; `None` at the end.
     fn next_of(
@@ -1089,5 +1094,47 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn files_compressed_whole_are_read_as_they_expand_and_bombs_refused() {
+        // an MCAP compressed whole: read from the stream, no copy
+        let dir = tempfile::tempdir().unwrap();
+        let bag = dir.path().join("z");
+        std::fs::create_dir(&bag).unwrap();
+        let mcap = zstd::encode_all(&write_mcap(true)[..], 3).unwrap();
+        std::fs::write(bag.join("b.mcap.zstd"), mcap).unwrap();
+        let (info, b) = read(&bag, None).unwrap();
+        assert_eq!((info.format, b.t), ("rosbag2 (MCAP)", vec![5, 9]));
+        // zeros, an SQLite header stating two pages then zeros: refused at once
+        let zeros = vec![0u8; 256 << 20];
+        let mut sqlite = SQLITE_MAGIC.to_vec();
+        sqlite.resize(100, 0);
+        sqlite[16..18].copy_from_slice(&4096u16.to_be_bytes());
+        sqlite[24..28].copy_from_slice(&7u32.to_be_bytes());
+        sqlite[28..32].copy_from_slice(&2u32.to_be_bytes());
+        sqlite[92..96].copy_from_slice(&7u32.to_be_bytes());
+        sqlite.extend(&zeros[..64 << 10]);
+        for (name, content, why) in [
+            ("b.mcap.zstd", &zeros[..], "neither an SQLite nor an MCAP"),
+            ("b.db3.zstd", &sqlite[..], "the size its header states"),
+        ] {
+            std::fs::remove_dir_all(&bag).unwrap();
+            std::fs::create_dir(&bag).unwrap();
+            std::fs::write(bag.join(name), zstd::encode_all(content, 19).unwrap()).unwrap();
+            let e = read(&bag, None).unwrap_err().to_string();
+            assert!(e.contains(why), "{e}");
+        }
+        // an MCAP that goes on as zeros, a thousand times its compressed size
+        let mut bomb = MCAP_MAGIC.to_vec();
+        bomb.extend(&zeros);
+        std::fs::remove_dir_all(&bag).unwrap();
+        std::fs::create_dir(&bag).unwrap();
+        std::fs::write(
+            bag.join("b.mcap.zstd"),
+            zstd::encode_all(&bomb[..], 19).unwrap(),
+        )
+        .unwrap();
+        assert!(read(&bag, None).is_err());
     }
 }
