@@ -527,3 +527,13 @@ impl StreamStats {
         Ok(s)
     }
 }
+
+/// Every event of `r` and what its header said (the readers' unit tests).
+#[cfg(test)]
+pub(crate) fn read_all(mut r: Box<dyn EventReader>) -> Result<(StreamInfo, EventBatch)> {
+    let mut all = EventBatch::default();
+    while let Some(b) = r.next_batch()? {
+        all.extend_from(&b);
+    }
+    Ok((r.info().clone(), all))
+}

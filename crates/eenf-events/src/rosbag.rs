@@ -569,16 +569,11 @@ mod tests {
     }
 
     fn read(bytes: Vec<u8>, topic: Option<&str>) -> Result<(StreamInfo, EventBatch)> {
-        let mut r = reader(
+        crate::read_all(reader(
             Box::new(std::io::Cursor::new(bytes)),
             Path::new("t.bag"),
             topic,
-        )?;
-        let mut all = EventBatch::default();
-        while let Some(b) = r.next_batch()? {
-            all.extend_from(&b);
-        }
-        Ok((r.info().clone(), all))
+        )?)
     }
 
     #[test]

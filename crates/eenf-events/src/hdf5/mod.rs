@@ -708,18 +708,13 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("e.h5");
         std::fs::write(&path, bytes).unwrap();
-        let mut r = crate::open_with(
+        crate::read_all(crate::open_with(
             &path,
             &crate::OpenOptions {
                 camera,
                 ..Default::default()
             },
-        )?;
-        let mut all = EventBatch::default();
-        while let Some(b) = r.next_batch()? {
-            all.extend_from(&b);
-        }
-        Ok((r.info().clone(), all))
+        )?)
     }
 
     /// The DSEC layout: one chunked, deflated dataset per field and a `t_offset`.

@@ -949,18 +949,13 @@ mod tests {
     }
 
     fn read(path: &Path, topic: Option<&str>) -> Result<(StreamInfo, EventBatch)> {
-        let mut r = crate::open_with(
+        crate::read_all(crate::open_with(
             path,
             &crate::OpenOptions {
                 topic: topic.map(str::to_string),
                 ..Default::default()
             },
-        )?;
-        let mut all = EventBatch::default();
-        while let Some(b) = r.next_batch()? {
-            all.extend_from(&b);
-        }
-        Ok((r.info().clone(), all))
+        )?)
     }
 
     #[test]
