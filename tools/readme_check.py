@@ -4,7 +4,7 @@
     python3 tools/readme_check.py [--eenf target/release/eenf] [--keep] [--only N]
 
 Every `$ command` line of the README's ```text blocks (and the set-up block's
-`cargo run --release -- …`) is run with bash in a fresh folder that has the shared data beside
+`cargo run -- …`) is run with bash in a fresh folder that has the shared data beside
 it (`--shared`, default the clone's `../shared`), so that `../shared/…` means what it means from
 the clone's root; `eenf` is the binary given (the
 release build by default, as `cargo install --path crates/eenf-cli` would put on the PATH).
@@ -64,9 +64,9 @@ def examples(readme):
             continue
         if not in_block:
             continue
-        if fence == "sh" and line.startswith("cargo run --release -- "):
+        if fence == "sh" and re.match(r"cargo run (--release )?-- ", line):
             # the set-up block: the demo, whose output the next text block shows
-            cmd = "eenf " + line.split("--release -- ", 1)[1].split("#")[0].strip()
+            cmd = "eenf " + line.split("-- ", 1)[1].split("#")[0].strip()
             pending_demo = (no, cmd)
             continue
         if fence != "text":

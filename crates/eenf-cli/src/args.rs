@@ -286,7 +286,7 @@ impl VideoArgs {
     }
 }
 
-/// Where a trace or report goes: a file (`-o`), and/or JSON on stdout.
+/// Where a trace or report goes: a file (`-o`), JSON on stdout, and/or a figure (`--plot`).
 #[derive(Debug, Clone, clap::Args)]
 pub struct TraceOutputArgs {
     /// Write the trace here: CSV (`time_s,enf_hz`), or JSON when the name ends in .json.
@@ -295,13 +295,25 @@ pub struct TraceOutputArgs {
     /// Print the trace and its metadata as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Plot the trace and each band's estimate, with the band taken (.png or .svg).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
 }
 
 impl TraceOutputArgs {
-    /// Writes the trace file, if one was asked for, and says so on stderr.
-    pub fn save(&self, trace: &eenf::trace::Trace) -> Result<()> {
+    /// Writes the trace file and the figure, if they were asked for (`source`: the recording,
+    /// named in the figure's title).
+    pub fn save(&self, trace: &eenf::trace::Trace, source: &std::path::Path) -> Result<()> {
         if let Some(out) = &self.output {
             eenf::output::write_atomic(out, |w| trace.write_for(out, w))?;
+        }
+        if let Some(p) = &self.plot {
+            let title = format!(
+                "{}: ENF, and each band's estimate (the band taken per {} s below)",
+                crate::plot::title_name(source),
+                trace.segment_s().unwrap_or(0.0)
+            );
+            crate::plot::plot_extraction(p, &title, trace)?;
         }
         Ok(())
     }
@@ -319,16 +331,17 @@ impl TraceOutputArgs {
         }
     }
 
-    /// Says where the trace went, and which of its estimates stand at the noise level
-    /// (stderr).
+    /// Says where the trace and the figure went, and which of the trace's estimates stand at
+    /// the noise level (stderr).
     pub fn report(&self, trace: &eenf::trace::Trace) {
         if let Some(note) = trace.noise_note() {
             eprintln!("warning: {note}");
         }
-        match &self.output {
-            Some(out) if eenf::output::is_stdout(out) => {}
-            Some(out) => eprintln!("trace written to {}", out.display()),
-            None => {}
+        if let Some(out) = self.output.as_ref().filter(|o| !eenf::output::is_stdout(o)) {
+            crate::terminal::announce("trace", out);
+        }
+        if let Some(p) = &self.plot {
+            crate::terminal::announce("plot", p);
         }
     }
 }

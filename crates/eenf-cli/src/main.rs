@@ -74,10 +74,17 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => e.exit(), // --help, --version
         Err(e) => {
-            // one line, as every other error: clap's first line says what is wrong
+            // clap's text whole: what is wrong, its suggestion ("a similar argument exists"),
+            // the missing argument's name and the usage line; a value out of its range is one
+            // line, as every other error (the pointer to --help adds nothing to it)
             let text = e.render().to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments");
-            eprintln!("eenf: {}", first.trim_end());
+            let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+            match lines[..] {
+                [first, more] if more.starts_with("For more information") => {
+                    eprintln!("eenf: {first}")
+                }
+                _ => eprintln!("eenf: {}", text.trim_end()),
+            }
             return ExitCode::from(2);
         }
     };

@@ -627,6 +627,10 @@ fn extraction<DB: DrawingBackend>(
     };
     let mut c = enf_panel(&upper, x, y)?;
     let inside = |v: f64| v >= y.0 && v <= y.1;
+    // what a band's estimate is divided by: 2m for flicker bands (2m·f0), k for hum (k·f0)
+    let f0 = tr.nominal_hz.unwrap_or((y.0 + y.1) / 2.0);
+    let divisor = |h: &eenf::trace::HarmonicPart| (h.center_hz / f0).round().max(1.0) as usize;
+    let flicker = tr.harmonics.iter().all(|h| divisor(h) == 2 * h.harmonic);
     for (k, h) in tr.harmonics.iter().enumerate() {
         let col = PALETTE[k % PALETTE.len()];
         let shown: Vec<f64> = h
@@ -640,11 +644,11 @@ fn extraction<DB: DrawingBackend>(
             .filter(|v| v.is_finite() && !inside(**v))
             .count();
         let label = match off {
-            0 => format!("{:.0} Hz band (÷{})", h.center_hz, 2 * h.harmonic),
+            0 => format!("{:.0} Hz band (÷{})", h.center_hz, divisor(h)),
             _ => format!(
                 "{:.0} Hz band (÷{}), {off} off the scale",
                 h.center_hz,
-                2 * h.harmonic
+                divisor(h)
             ),
         };
         let mut first = true;
@@ -707,7 +711,11 @@ fn extraction<DB: DrawingBackend>(
         .map_err(e)?;
     c.configure_mesh()
         .x_desc("time from recording start (s)")
-        .y_desc("band taken (m: 2m·f0)")
+        .y_desc(if flicker {
+            "band taken (m: 2m·f0)"
+        } else {
+            "band taken (k: k·f0)"
+        })
         .y_labels(mmax as usize)
         .y_label_formatter(&|v| tick(*v, 0))
         .x_label_formatter(&|v| whole_or_tenths(*v))

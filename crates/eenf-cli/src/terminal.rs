@@ -80,6 +80,12 @@ pub fn clean_up_on_signals() -> Result<()> {
     Ok(())
 }
 
+/// Says on stderr that a file was written, the same way for every command and kind of file
+/// (`trace written to out.csv`).
+pub fn announce(what: &str, path: &std::path::Path) {
+    eprintln!("{what} written to {}", path.display());
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -8,7 +8,7 @@
 //! line back into one lobe; its peak is then the frequency at the window's centre, as for a
 //! line that holds still (Kay, *Fundamentals of Statistical Signal Processing* I, §13.6, for
 //! the chirp model; on weak 4 f0 hum following a real grid it lowers the error from
-//! 1.1–4.3 mHz to 0.6–1.1 mHz, see `crates/eenf/tests/audio_harmonics.rs`).
+//! 1.1–4.3 mHz to 0.6–1.1 mHz, see `crates/eenf/tests/integration/audio_harmonics.rs`).
 
 use std::f64::consts::PI;
 

@@ -165,8 +165,9 @@ pub fn read_audio(path: &Path, opts: &AudioOptions) -> Result<Audio> {
             return read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {e}", path.display()))
         }
         // its MP4 reader can allocate from damaged box sizes past the memory there is (an
-        // abort no panic guard catches): MP4 goes to ffmpeg where it is installed
-        Container::Mp4 if ffmpeg_installed() => {
+        // abort no panic guard catches): MP4, M4A and MOV go to ffmpeg, always, so that a file
+        // gives one trace whether or not ffmpeg is installed (or a clear error without it)
+        Container::Mp4 => {
             return read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {e}", path.display()))
         }
         _ => {}
@@ -207,16 +208,6 @@ fn container_of(file: &mut std::fs::File) -> Container {
         [_, _, _, _, b'f', b't', b'y', b'p'] => Container::Mp4,
         _ => Container::Other,
     }
-}
-
-/// Whether the ffmpeg programs are there to be run.
-fn ffmpeg_installed() -> bool {
-    Command::new("ffprobe")
-        .arg("-version")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
 }
 
 /// A recording's sound: a file (any format [`read_audio`] reads), or samples already in
@@ -331,7 +322,9 @@ fn read_symphonia(
             &FormatOptions::default(),
             &MetadataOptions::default(),
         )
-        .map_err(|e| Unreadable::Format(format!("not an audio format eenf reads itself ({e})")))?;
+        .map_err(|_| {
+            Unreadable::Format("not WAV, FLAC, MP3 or OGG, which eenf reads itself".into())
+        })?;
     let mut format = probed.format;
     let Some(track) = format
         .tracks()
@@ -346,9 +339,7 @@ fn read_symphonia(
     let params = track.codec_params.clone();
     let mut decoder = symphonia::default::get_codecs()
         .make(&params, &DecoderOptions::default())
-        .map_err(|e| {
-            Unreadable::Format(format!("its audio codec is not one eenf decodes ({e})"))
-        })?;
+        .map_err(|_| Unreadable::Format("its audio codec is not one eenf decodes itself".into()))?;
     let fs = params.sample_rate.unwrap_or(0) as f64;
     if fs <= 0.0 {
         return Err(Unreadable::Other(anyhow!(

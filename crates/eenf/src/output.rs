@@ -77,6 +77,17 @@ impl AtomicFile {
         if target.is_dir() {
             bail!("{}: is a folder, not a file", path.display());
         }
+        if path.as_os_str().to_string_lossy().ends_with('/') {
+            bail!(
+                "{}: names a folder (it ends in /), not a file: give the file's name, e.g. {}out{}",
+                path.display(),
+                path.display(),
+                match suffix.rsplit_once('.') {
+                    Some((_, ext)) if !ext.is_empty() && ext != "tmp" => format!(".{ext}"),
+                    _ => ".csv".into(),
+                }
+            );
+        }
         let special = is_stdout(path) || is_special_file(&target);
         if !special {
             create_parent(&target)?;
@@ -201,6 +212,20 @@ pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_name_that_ends_in_a_slash_is_a_folder_not_made() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = format!("{}/out/", dir.path().display());
+        let Err(e) = AtomicFile::create(Path::new(&out)) else {
+            panic!("{out} taken as a file");
+        };
+        assert!(
+            e.to_string().contains("names a folder (it ends in /)"),
+            "{e}"
+        );
+        assert!(!dir.path().join("out").exists());
+    }
 
     #[test]
     fn written_whole_through_links_and_devices() {

@@ -182,11 +182,11 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             w.write_all(md.as_bytes())?;
             Ok(())
         })?;
-        eprintln!("report written to {}", p.display());
+        crate::terminal::announce("report", p);
     }
     if let Some(p) = &a.csv {
         write_atomic(p, |w| write_csv(w, &recs, &runs))?;
-        eprintln!("CSV written to {}", p.display());
+        crate::terminal::announce("CSV", p);
     }
     let v = serde_json::json!({
         "dataset": a.dataset,
@@ -205,7 +205,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             writeln!(w)?;
             Ok(())
         })?;
-        eprintln!("JSON written to {}", p.display());
+        crate::terminal::announce("JSON", p);
     }
     if scored == 0 {
         bail!("no recording could be scored");

@@ -77,6 +77,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             m.mae_hz * 1e3
         );
         plot_comparison(p, &title, &c.time_s, &c.estimate, &c.reference)?;
+        crate::terminal::announce("plot", p);
     }
     if a.json {
         let v = serde_json::json!({

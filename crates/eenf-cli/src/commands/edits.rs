@@ -39,10 +39,14 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     }
     if let Some(out) = &a.output {
         eenf::output::write_atomic(out, |w| Ok(w.write_all(report.to_json().as_bytes())?))?;
+        if !eenf::output::is_stdout(out) {
+            crate::terminal::announce("report", out);
+        }
     }
     if let Some(plot) = &a.plot {
         let title = format!("{}: {}", crate::plot::title_name(&a.file), report.verdict);
         crate::plot::plot_edits(plot, &title, &report)?;
+        crate::terminal::announce("plot", plot);
     }
     let lines: Vec<String> = report.lines_hz.iter().map(|f| format!("{f:.0}")).collect();
     eprintln!(

@@ -2,7 +2,6 @@
 
 use std::path::PathBuf;
 
-use crate::plot::plot_extraction;
 use anyhow::Result;
 use eenf::extract::extract_file;
 use eenf::progress::Progress;
@@ -16,9 +15,6 @@ pub struct Args {
     pub file: PathBuf,
     #[command(flatten)]
     pub out: TraceOutputArgs,
-    /// Plot the per-harmonic traces and the selection (.png or .svg).
-    #[arg(long)]
-    pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub method: MethodArgs,
 }
@@ -29,15 +25,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let started = std::time::Instant::now();
     let trace = extract_file(&a.file, &opts, &progress)?;
     let took = started.elapsed().as_secs_f64();
-    a.out.save(&trace)?;
-    if let Some(p) = &a.plot {
-        let title = format!(
-            "{}: ENF, and each band's estimate (the band taken per {} s below)",
-            crate::plot::title_name(&a.file),
-            trace.segment_s().unwrap_or(0.0)
-        );
-        plot_extraction(p, &title, &trace)?;
-    }
+    a.out.save(&trace, &a.file)?;
     if let Some(x) = trace.events() {
         for n in &x.notes {
             eprintln!("note: {n}");
@@ -61,8 +49,5 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         );
     }
     a.out.report(&trace);
-    if let Some(p) = &a.plot {
-        eprintln!("plot written to {}", p.display());
-    }
     a.out.print(&trace)
 }

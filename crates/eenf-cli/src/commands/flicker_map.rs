@@ -65,7 +65,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         map.seconds
     );
     if let Some(p) = &picture {
-        eprintln!("map written to {}", p.display());
+        crate::terminal::announce("map", p);
     }
     if a.json {
         outln!("{}", serde_json::to_string_pretty(&map)?);

@@ -80,6 +80,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             &q[..n],
             &(k..k + n).map(|i| r.values.get(i)).collect::<Vec<_>>(),
         )?;
+        crate::terminal::announce("plot", p);
     }
     if a.json {
         let v = located.to_json(&a.trace, query.alpha);

@@ -39,7 +39,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     for w in &trace.warnings {
         eprintln!("warning: {w}");
     }
-    a.out.save(&trace)?;
+    a.out.save(&trace, &a.file)?;
     let finite: Vec<f64> = trace.finite().collect();
     let mean = finite.iter().sum::<f64>() / finite.len().max(1) as f64;
     let sd = (finite.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / finite.len().max(1) as f64)

@@ -25,7 +25,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let started = std::time::Instant::now();
     let trace = eenf::video::trace_video(&a.file, &opts, &progress)?;
     let took = started.elapsed().as_secs_f64();
-    a.out.save(&trace)?;
+    a.out.save(&trace, &a.file)?;
     if let Some(Provenance::Video(v)) = &trace.provenance {
         let rows = v
             .virtual_rows

@@ -11,7 +11,7 @@
 //! 50 Hz mains (`../shared/enf-reference` and `../shared/mains-day`, one day in Wuhan), its
 //! spread is that of a normal bulk, and the rate per hour at which |Δ| passes x degrees falls
 //! as A·e^(−x/b) ([`STRAY_TAILS`], per side length; re-measured by
-//! `crates/eenf/tests/shared_edits_null.rs`). The rate at a boundary is the field's, its noise
+//! `crates/eenf/tests/integration/shared_edits_null.rs`). The rate at a boundary is the field's, its noise
 //! widened by the stray's bulk, plus the stray's tail at its jump (the exponential convolved
 //! with the boundary's normal noise).
 

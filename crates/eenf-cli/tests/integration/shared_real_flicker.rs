@@ -3,9 +3,8 @@
 //! truth exists; the independent spectral analysis in `shared/fixtures/README.md` gives each
 //! file's flicker line. `#[ignore]`d (needs the shared data); `.ci/run` runs it.
 
-mod cli;
-#[path = "../../eenf/tests/common/mod.rs"]
-mod common;
+use crate::cli;
+use crate::common;
 
 use std::path::PathBuf;
 

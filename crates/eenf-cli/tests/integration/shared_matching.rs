@@ -9,8 +9,7 @@ use eenf_core::Nominal;
 use eenf_dsp::matching::{match_trace, MatchOptions, DEFAULT_ALPHA};
 use eenf_dsp::EnfParams;
 
-#[path = "../../eenf/tests/common/mod.rs"]
-mod common;
+use crate::common;
 
 fn shared() -> PathBuf {
     common::shared("enf-traces-60hz")

@@ -2,7 +2,7 @@
 //! ENF from a trace CSV, a dataset laid out like EV-ENFD with references that agree with the
 //! truth, and the same seed giving the same files.
 
-mod cli;
+use crate::cli;
 use cli::{eenf, json, ok};
 
 #[test]

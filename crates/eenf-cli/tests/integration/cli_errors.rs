@@ -5,7 +5,7 @@ use std::process::Command;
 
 use eenf_events::{Aedat4Writer, Compression};
 
-mod cli;
+use crate::cli;
 
 fn eenf(args: &[&str], dir: &Path) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_eenf"))

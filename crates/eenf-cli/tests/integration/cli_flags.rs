@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-mod cli;
+use crate::cli;
 
 /// An option of a command, as its `--help` lists it.
 #[derive(Debug)]
@@ -271,4 +271,32 @@ fn every_flag_the_readme_shows_exists() {
         "README flags that do not exist: {missing:#?}"
     );
     assert!(checked >= 100, "only {checked} README flags checked");
+}
+
+#[test]
+fn mistyped_commands_keep_the_parsers_help() {
+    let d = Path::new(".");
+    let err = cli::fails(&["extract", "FILE", "--ouput", "x.csv"], d);
+    assert!(
+        err.contains("a similar argument exists: '--output'")
+            && err.contains("Usage: eenf extract"),
+        "{err}"
+    );
+    let err = cli::fails(&["extrat"], d);
+    assert!(
+        err.contains("a similar subcommand exists: 'extract'"),
+        "{err}"
+    );
+    let err = cli::fails(&["extract"], d);
+    assert!(
+        err.contains("not provided") && err.contains("<FILE>"),
+        "{err}"
+    );
+    // an output named as a folder that does not exist
+    let tmp = tempfile::tempdir().unwrap();
+    let err = cli::fails(
+        &["simulate", "--duration", "1", "-o", "nowhere/"],
+        tmp.path(),
+    );
+    assert!(err.contains("names a folder (it ends in /)"), "{err}");
 }

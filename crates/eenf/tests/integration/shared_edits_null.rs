@@ -10,7 +10,7 @@
 //! - The two ENF-WHU references with a genuine 180° break (`real-discontinuities`): each
 //!   found within 1 s, read as a half-cycle turn, and nothing else.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

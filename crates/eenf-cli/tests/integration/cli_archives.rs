@@ -5,7 +5,7 @@
 use std::io::Write;
 use std::path::Path;
 
-mod cli;
+use crate::cli;
 use cli::eenf;
 
 use eenf::refdb::RefSeries;

@@ -2,7 +2,7 @@
 //! equal `eenf compare` on the same traces, a manifest with a recording across an hour and a
 //! corrupt file, sweeps, and clear errors (also for `eenf video`).
 
-mod cli;
+use crate::cli;
 use cli::{eenf, fails, ok};
 
 /// Rows of a CSV with a header, as maps.

@@ -1,7 +1,7 @@
 //! Events and sound in memory (what the Python package hands over) give the traces of their
 //! files: the same reader path, the same decimation.
 
-mod cli;
+use crate::cli;
 
 use std::path::Path;
 use std::sync::Arc;

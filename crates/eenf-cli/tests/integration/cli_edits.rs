@@ -2,7 +2,7 @@
 //! wanders smoothly, in white noise, whole and with a stretch cut out; the JSON layout; the
 //! figure; a recording with no hum refused; a trace tested for frequency steps.
 
-mod cli;
+use crate::cli;
 
 use std::f64::consts::PI;
 use std::path::Path;

@@ -8,7 +8,7 @@
 //!
 //! `EENF_EDITS_SCALE` multiplies the number of clips (default 1).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -2,12 +2,11 @@
 //! are those recordings, and E-ENF scored on it per class. Needs `../shared` (run by `.ci/run`
 //! with `--ignored`).
 
-#[path = "../../eenf/tests/common/mod.rs"]
-mod common;
+use crate::common;
 
 use std::path::Path;
 
-mod cli;
+use crate::cli;
 use cli::ok;
 
 #[test]

@@ -2,7 +2,7 @@
 //! tracked; hum at f0 alone, or only at 2f0 or 3f0; other formats through Symphonia and
 //! ffmpeg (those need the `ffmpeg` program and run with the ignored tests in `.ci/run`).
 
-mod cli;
+use crate::cli;
 
 use std::f64::consts::PI;
 use std::path::Path;
@@ -132,7 +132,12 @@ fn hum_only_at_a_harmonic_is_traced_and_the_harmonic_named() {
     let d = tmp.path();
     for m in [2.0, 3.0] {
         write_hum(&d.join("h.wav"), 8000, 90.0, &[(m, 0.03)], 1);
-        let out = cli::eenf(&["reference", "h.wav", "--json", "-o", "h.json"], d);
+        let out = cli::eenf(
+            &[
+                "audio", "h.wav", "--json", "-o", "h.json", "--plot", "h.svg",
+            ],
+            d,
+        );
         assert!(
             out.status.success(),
             "{}",
@@ -140,6 +145,16 @@ fn hum_only_at_a_harmonic_is_traced_and_the_harmonic_named() {
         );
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(&format!("{m} x f0")), "{err}");
+        // every written file is announced alike; the figure names the band by its k·f0
+        assert!(
+            err.contains("trace written to h.json") && err.contains("plot written to h.svg"),
+            "{err}"
+        );
+        let svg = std::fs::read_to_string(d.join("h.svg")).unwrap();
+        assert!(
+            svg.contains(&format!("(÷{m})")) && svg.contains("k·f0"),
+            "{m}"
+        );
         let j = json(&String::from_utf8_lossy(&out.stdout));
         assert_eq!(j["nominal_hz"], 50.0);
         let picked: Vec<u64> = j["selected"]

@@ -5,11 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
-mod cli;
+use crate::cli;
 use cli::{eenf, ok};
 
-#[path = "../../eenf/tests/common/mod.rs"]
-mod common;
+use crate::common;
 
 fn archives() -> PathBuf {
     common::shared("fixtures/grid-archives")

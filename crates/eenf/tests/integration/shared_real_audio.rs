@@ -14,7 +14,7 @@ use eenf_core::Nominal;
 use eenf_dsp::{agreement, search_hum, EnfParams};
 use eenf_sim::MainsPhase;
 
-mod common;
+use crate::common;
 
 fn real_audio(name: &str) -> PathBuf {
     common::shared("fixtures")

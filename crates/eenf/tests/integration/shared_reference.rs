@@ -7,7 +7,7 @@ use eenf::mains::reference_file;
 use eenf_core::Nominal;
 use eenf_dsp::{EnfParams, PeakMethod};
 
-mod common;
+use crate::common;
 
 fn shared() -> PathBuf {
     common::shared("enf-reference")

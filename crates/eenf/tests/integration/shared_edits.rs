@@ -12,7 +12,7 @@
 //!
 //! `EENF_EDITS_SCALE` multiplies the number of clips (default 1).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

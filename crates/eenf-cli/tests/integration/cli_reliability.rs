@@ -2,7 +2,7 @@
 //! the cases of the reliability issue, each run as a user runs them. Links and files are made
 //! inside a temporary folder only (never a real `/dev` path).
 
-mod cli;
+use crate::cli;
 
 use std::io::Write;
 use std::path::Path;

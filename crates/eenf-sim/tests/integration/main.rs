@@ -1,0 +1,5 @@
+//! The integration tests of `eenf-sim`, one test binary (each file was its own binary,
+//! linking the whole workspace again).
+
+mod extract_truth;
+mod physics;
