@@ -37,16 +37,17 @@ ZSTD_MAGIC = b"\x28\xb5\x2f\xfd"
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
+def block_header(size, kind, last):
+    """A zstd block header (RFC 8878 §3.1.1.2): size, type (0 raw, 1 RLE), last-block bit."""
+    return struct.pack("<I", (size << 3) | (kind << 1) | last)[:3]
+
+
 def zstd_frame(first, zeros):
     """A zstd frame holding `first` (a raw block), then `zeros` bytes of zeros in RLE blocks of
     128 KiB (RFC 8878 §3.1.1): four bytes of frame per 128 KiB, so GiBs fit in KBs."""
     out = bytearray(ZSTD_MAGIC + bytes([0x00, 0x58]))  # no content size; window 8 MiB
     block = 128 << 10
-
-    def header(size, kind, last):
-        v = (size << 3) | (kind << 1) | last
-        return struct.pack("<I", v)[:3]
-
+    header = block_header
     if first:
         out += header(len(first), 0, 0) + first
     n = zeros // block
@@ -60,10 +61,7 @@ def zstd_slow(path, gib=2):
     its size, under the bound): seconds of honest expansion to kill in the middle."""
     out = bytearray(ZSTD_MAGIC + bytes([0x00, 0x58]))
     rng = random.Random(0)
-
-    def header(size, kind, last):
-        return struct.pack("<I", (size << 3) | (kind << 1) | last)[:3]
-
+    header = block_header
     first = sqlite_header(pages=(gib << 30) // 4096)
     out += header(len(first), 0, 0) + first
     units = (gib << 30) // (128 << 10)
@@ -162,9 +160,9 @@ def hdf5_bomb_members(shared, rng, d):
                 continue
             body = bytearray(ZSTD_MAGIC + bytes([0x00, 0x58]))
             n = (size - 6 - 4) // 4
-            body += (struct.pack("<I", ((128 << 10) << 3) | 2)[:3] + b"\0") * n
+            body += (block_header(128 << 10, 1, 0) + b"\0") * n
             rest = size - len(body) - 3
-            body += struct.pack("<I", (rest << 3) | 1)[:3] + bytes(rest)
+            body += block_header(rest, 0, 1) + bytes(rest)
             b[at:at + size] = body
         p = os.path.join(d, f"hdf5_zstd_bomb_{k}.h5")
         open(p, "wb").write(b)
