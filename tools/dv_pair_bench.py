@@ -5,7 +5,7 @@ opening the recording to its last batch, so its interpreter start is not counted
 
 Usage: python tools/dv_pair_bench.py [FILE] [--runs N] [--bin PATH ...] [--dv-written]
 
-FILE defaults to target/tmp/bench-60s-LZ4.aedat4 (made by `cargo bench -p eenf`, 120 M events).
+FILE defaults to target/tmp/bench-60s-LZ4.aedat4 (made by `cargo bench -p eenf-bench`, 120 M events).
 `--dv-written` benchmarks a copy of FILE re-written by dv-processing (its own LZ4 settings:
 64 KiB linked blocks, the layout of files recorded with DV), made once beside FILE.
 
@@ -57,7 +57,7 @@ def main():
     bins = a.bin or [os.path.join(ROOT, "target/release/eenf")]
     path = a.file
     if not os.path.exists(path):
-        sys.exit(f"{path}: missing (cargo bench -p eenf makes it)")
+        sys.exit(f"{path}: missing (cargo bench -p eenf-bench makes it)")
     if a.dv_written:
         dv_path = path.replace(".aedat4", "-dv.aedat4")
         if not os.path.exists(dv_path):

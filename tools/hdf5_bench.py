@@ -3,7 +3,7 @@ has), on the same file.
 
     python tools/hdf5_bench.py write [MILLION_EVENTS]   # target/tmp/dsec-bench.h5 (default 100)
     python tools/hdf5_bench.py peer                     # h5py reads x, y, p, t into numpy
-    cargo bench -p eenf-events --bench containers -- dsec   # eenf's EventReader on the same file
+    cargo bench -p eenf-bench --bench containers -- dsec   # eenf's EventReader on the same file
 
 The file is laid out as DSEC's `events_left/events.h5`: `events/{x u16, y u16, p u8, t u32}`,
 `ms_to_idx`, `t_offset`, every dataset compressed with blosc + zstd (hdf5plugin's Blosc,

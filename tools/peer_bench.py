@@ -1,4 +1,4 @@
-"""Decode speed of the peer libraries on the files `cargo bench -p eenf` generates (in
+"""Decode speed of the peer libraries on the files `cargo bench -p eenf-bench` generates (in
 target/tmp), for the table in the README. Usage: python tools/peer_bench.py [SECONDS]
 
 Needs: pip install dv-processing aedat expelliarmus evlib numpy (best in a venv)."""

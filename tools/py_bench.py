@@ -1,7 +1,7 @@
 """Speed and memory of the Python package, for the README (a benchmark, not a test).
 
 Usage: python tools/py_bench.py [FILE] [--runs N]
-FILE defaults to target/tmp/bench-60s-LZ4.aedat4 (`cargo bench -p eenf --bench pipeline`
+FILE defaults to target/tmp/bench-60s-LZ4.aedat4 (`cargo bench -p eenf-bench --bench pipeline`
 writes it); the venv needs eenf (pip install ./crates/eenf-py) and dv-processing.
 
 Each measure runs in a fresh interpreter, alternating between the two sides (paired runs),
@@ -118,7 +118,7 @@ def main():
         runs = int(sys.argv[sys.argv.index("--runs") + 1])
     path = args[0] if args else os.path.join(REPO, "target", "tmp", "bench-60s-LZ4.aedat4")
     if not os.path.exists(path):
-        raise SystemExit(f"{path}: missing (cargo bench -p eenf --bench pipeline writes it)")
+        raise SystemExit(f"{path}: missing (cargo bench -p eenf-bench --bench pipeline writes it)")
     print(f"{path}: {os.path.getsize(path) / 1e6:.0f} MB")
     print("1. events into numpy")
     paired("eenf.read_events", lambda: run_py(READ_EENF, path),

@@ -3,7 +3,7 @@
 //! metavision_driver publishes each millisecond at 2 M events/s.
 //!
 //! The files are written once into the target folder (`EENF_BENCH_SECONDS`, default 10 s =
-//! 20 M events); `cargo bench -p eenf-events --bench containers` prints events/s.
+//! 20 M events); `cargo bench -p eenf-bench --bench containers` prints events/s.
 //!
 //! `dsec`: a DSEC-layout HDF5 file (blosc + zstd), when `tools/hdf5_bench.py write` has made
 //! one (`target/tmp/dsec-bench.h5`); `tools/hdf5_bench.py peer` times h5py on the same file.

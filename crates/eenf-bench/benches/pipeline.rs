@@ -2,7 +2,7 @@
 //! of events sharing a timestamp, polarity following a 100 Hz flicker.
 //!
 //! The file is generated once into the target folder (`EENF_BENCH_SECONDS`, default 20 s =
-//! 40 M events) and reused; `cargo bench -p eenf` prints events/s ("elem/s").
+//! 40 M events) and reused; `cargo bench -p eenf-bench` prints events/s ("elem/s").
 #![allow(missing_docs)] // criterion_group! makes undocumented public functions
 
 use std::path::PathBuf;

@@ -26,6 +26,7 @@ fn num(row: &std::collections::HashMap<String, String>, key: &str) -> f64 {
 }
 
 #[test]
+#[ignore = "long (30 s): run by .ci/run with the real-data checks"]
 fn bench_gives_table_2_and_the_numbers_of_compare_on_the_same_traces() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();

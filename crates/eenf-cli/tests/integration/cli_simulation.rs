@@ -240,6 +240,7 @@ fn bad_simulation_options_are_refused_clearly() {
 /// A daylit room where only a lamp's pool flickers and a person walks by, seen by a sensor that
 /// stamps every event on its own (~7 k events/s): traced with the defaults against the truth.
 #[test]
+#[ignore = "long (12 s): run by .ci/run with the real-data checks"]
 fn a_lamp_spot_seen_event_by_event_is_traced_with_the_defaults() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
