@@ -56,8 +56,13 @@ fn render(
     let tmp = out.path().to_path_buf();
     let res = match ext.as_str() {
         "png" => {
-            let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
-            draw(&root).and_then(|_| root.present().map_err(e))
+            // drawn into memory and encoded here, so that plotters needs no image crate
+            let mut rgb = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+                draw(&root).and_then(|_| root.present().map_err(e))?;
+            }
+            write_png(out.file()?, &rgb)
         }
         "svg" => {
             let root = SVGBackend::new(&tmp, SIZE).into_drawing_area();
@@ -69,6 +74,16 @@ fn render(
         Ok(()) => out.commit(),
         Err(err) => Err(err.context(format!("{}: cannot draw the plot", path.display()))),
     }
+}
+
+/// An RGB image of `SIZE` as PNG (8 bits per channel, the encoder's default compression).
+fn write_png(file: std::fs::File, rgb: &[u8]) -> Result<()> {
+    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), SIZE.0, SIZE.1);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut w = enc.write_header().map_err(e)?;
+    w.write_image_data(rgb).map_err(e)?;
+    w.finish().map_err(e)
 }
 
 fn range(vals: impl Iterator<Item = f64>) -> (f64, f64) {
