@@ -53,19 +53,17 @@ fn render(
         bail!("{}: plots are written as .png or .svg", path.display());
     }
     let out = eenf::output::AtomicFile::keeping_extension(path)?;
-    let tmp = out.path().to_path_buf();
     let res = match ext.as_str() {
         "png" => {
             // drawn into memory and encoded here, so that plotters needs no image crate
             let mut rgb = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
-            {
-                let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
-                draw(&root).and_then(|_| root.present().map_err(e))?;
-            }
-            write_png(out.file()?, &rgb)
+            let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+            let drawn = draw(&root).and_then(|_| root.present().map_err(e));
+            drop(root);
+            drawn.and_then(|_| write_png(out.file()?, &rgb))
         }
         "svg" => {
-            let root = SVGBackend::new(&tmp, SIZE).into_drawing_area();
+            let root = SVGBackend::new(out.path(), SIZE).into_drawing_area();
             draw_svg(&root).and_then(|_| root.present().map_err(e))
         }
         _ => bail!("{}: plots are written as .png or .svg", path.display()),
