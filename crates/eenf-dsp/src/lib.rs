@@ -58,20 +58,3 @@ pub use postprocess::{
 pub use sampling::{Grouping, PolaritySequence, SamplingError, SamplingMethod, TemporalSampler};
 pub use spectrogram::{spectrogram, Spectrogram};
 pub use tracker::{PeakMethod, StftTracker, NOISE_LEVEL_DB};
-
-/// Close to Gaussian noise of unit variance (a sum of twelve uniforms from xorshift64), from
-/// `seed`: the unit tests' noise.
-#[cfg(test)]
-pub(crate) fn test_noise(mut seed: u64) -> impl FnMut() -> f64 {
-    move || {
-        (0..12)
-            .map(|_| {
-                seed ^= seed << 13;
-                seed ^= seed >> 7;
-                seed ^= seed << 17;
-                (seed >> 11) as f64 / (1u64 << 53) as f64
-            })
-            .sum::<f64>()
-            - 6.0
-    }
-}

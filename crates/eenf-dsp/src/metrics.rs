@@ -66,23 +66,3 @@ pub fn robust_spread(v: &[f64]) -> f64 {
     let mut dev: Vec<f64> = v.iter().map(|x| (x - centre).abs()).collect();
     1.4826 * *dev.select_nth_unstable_by(mid, f64::total_cmp).1
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn known_values() {
-        let a = [1.0, 2.0, 3.0, 4.0];
-        let b = [2.0, 4.0, 6.0, 8.0];
-        let m = agreement(&a, &b).unwrap();
-        assert!((m.cc - 1.0).abs() < 1e-12);
-        assert!((m.mae_hz - 2.5).abs() < 1e-12);
-        assert!((m.rmse_hz - 7.5f64.sqrt()).abs() < 1e-12);
-        assert_eq!(m.max_err_hz, 4.0);
-        let m = agreement(&a, &[4.0, 3.0, 2.0, f64::NAN]).unwrap();
-        assert!((m.cc + 1.0).abs() < 1e-12);
-        assert_eq!(m.n, 3);
-        assert!(agreement(&[1.0], &[1.0]).is_none());
-    }
-}

@@ -34,6 +34,7 @@ pub use camera::{render_video, CameraConfig, VideoStats};
 pub use lamp::{Lamp, LampBank, LampKind};
 pub use mains::{phase_from_start, MainsError, MainsPhase, SyntheticEnf};
 pub use scene::{
-    person, walker, MovingObject, Region, Scene, SceneConfig, SceneKind, Shake, CHANNELS, MAX_LAMPS,
+    person, walker, Frame, MovingObject, Pose, Region, Scene, SceneConfig, SceneKind, Shake,
+    CHANNELS, MAX_LAMPS,
 };
-pub use sensor::{simulate, PixelConfig, Readout, SimConfig, SimStats};
+pub use sensor::{fast_ln, simulate, PixelConfig, Readout, SimConfig, SimStats};

@@ -19,7 +19,8 @@ mod config;
 mod pixel;
 
 pub use config::{PixelConfig, Readout, SimConfig, SimStats};
-use pixel::{fast_ln, mix_light, photoreceptor_pass, Light, PixelConsts, PixelState, StepLight};
+pub use pixel::fast_ln;
+use pixel::{mix_light, photoreceptor_pass, Light, PixelConsts, PixelState, StepLight};
 
 /// Time steps simulated together (one output batch).
 const WINDOW_STEPS: usize = 250;

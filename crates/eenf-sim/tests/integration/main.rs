@@ -3,3 +3,7 @@
 
 mod extract_truth;
 mod physics;
+mod unit_lamp;
+mod unit_mains;
+mod unit_scene;
+mod unit_sensor_pixel;
