@@ -35,7 +35,7 @@ mod prefetch;
 pub mod prophesee;
 pub mod rosbag;
 pub mod rosbag2;
-mod rosmsg;
+pub mod rosmsg;
 pub mod spool;
 mod stream;
 pub mod text;
@@ -526,14 +526,4 @@ impl StreamStats {
         }
         Ok(s)
     }
-}
-
-/// Every event of `r` and what its header said (the readers' unit tests).
-#[cfg(test)]
-pub(crate) fn read_all(mut r: Box<dyn EventReader>) -> Result<(StreamInfo, EventBatch)> {
-    let mut all = EventBatch::default();
-    while let Some(b) = r.next_batch()? {
-        all.extend_from(&b);
-    }
-    Ok((r.info().clone(), all))
 }

@@ -28,7 +28,7 @@ use crate::EventBatch;
 
 /// What a message type carries, and so how it is read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Kind {
+pub enum Kind {
     /// An array of events with their own stamps (dvs_msgs, prophesee_event_msgs).
     Events,
     /// A packet of a camera's encoding (event_camera_msgs, event_array_msgs).
@@ -37,7 +37,7 @@ pub(crate) enum Kind {
 
 /// The kind of a message type named the ROS 1 way (`dvs_msgs/EventArray`) or the ROS 2 way
 /// (`dvs_msgs/msg/EventArray`); `None` for types that carry no events.
-pub(crate) fn kind_of(msg_type: &str) -> Option<Kind> {
+pub fn kind_of(msg_type: &str) -> Option<Kind> {
     match msg_type.replace("/msg/", "/").as_str() {
         "dvs_msgs/EventArray" | "prophesee_event_msgs/EventArray" => Some(Kind::Events),
         "event_camera_msgs/EventPacket" | "event_array_msgs/EventArray" => Some(Kind::Packet),
@@ -46,12 +46,12 @@ pub(crate) fn kind_of(msg_type: &str) -> Option<Kind> {
 }
 
 /// The event message types read, for messages naming what a bag lacks.
-pub(crate) const TYPES: &str =
+pub const TYPES: &str =
     "dvs_msgs/EventArray, prophesee_event_msgs/EventArray, event_camera_msgs/EventPacket, event_array_msgs/EventArray";
 
 /// How a message's bytes are laid out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Serialization {
+pub enum Serialization {
     /// ROS 1: little-endian, no padding.
     Ros1,
     /// ROS 2 CDR (byte order and alignment from the encapsulation header).
@@ -62,7 +62,7 @@ type Res<T> = std::result::Result<T, String>;
 
 /// Why a message could not be decoded.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub(crate) enum Fault {
+pub enum Fault {
     /// Its bytes are damaged or cut short.
     Damaged(String),
     /// It is sound but in a form eenf does not read (an encoding, a byte order).
@@ -215,7 +215,7 @@ impl<'a> Cursor<'a> {
 
 /// Decodes the event messages of one topic, keeping what carries from one message to the
 /// next (the EVT 3.0 clock, the x of `libcaer_cmp`).
-pub(crate) struct MessageDecoder {
+pub struct MessageDecoder {
     kind: Kind,
     evt3: Evt3,
     cmp: CaerCmp,
@@ -344,7 +344,7 @@ fn micros(ns: u64) -> i64 {
 }
 
 /// `libcaer`: libcaer's polarity events (`u32` data, `i32` time), 31-bit µs clock.
-fn libcaer(bytes: &[u8], time_base: u64, out: &mut EventBatch) {
+pub fn libcaer(bytes: &[u8], time_base: u64, out: &mut EventBatch) {
     let mut high = time_base;
     let mut last = 0u64;
     for e in bytes.chunks_exact(8) {
@@ -365,7 +365,7 @@ fn libcaer(bytes: &[u8], time_base: u64, out: &mut EventBatch) {
 }
 
 /// `mono`: one `u64` an event.
-fn mono(bytes: &[u8], time_base: u64, out: &mut EventBatch) {
+pub fn mono(bytes: &[u8], time_base: u64, out: &mut EventBatch) {
     for e in bytes.chunks_exact(8) {
         let w = u64::from_le_bytes(e.try_into().unwrap_or_default());
         out.push(
@@ -380,14 +380,16 @@ fn mono(bytes: &[u8], time_base: u64, out: &mut EventBatch) {
 /// The state of the `libcaer_cmp` decoder: the x of the last address word, the base y and
 /// polarity of the last vector, which carry across messages.
 #[derive(Debug, Default)]
-struct CaerCmp {
+pub struct CaerCmp {
     x: u16,
     base_y: u16,
     polarity: bool,
 }
 
 impl CaerCmp {
-    fn decode(
+    /// Appends the events of one message's `libcaer_cmp` words to `out`: stamps from
+    /// `time_base` (ns), events outside a `width` × `height` sensor dropped.
+    pub fn decode(
         &mut self,
         bytes: &[u8],
         time_base: u64,
@@ -429,101 +431,5 @@ impl CaerCmp {
                 _ => {}
             }
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn cdr_fields_are_aligned_from_the_encapsulation_header() {
-        // header: stamp 1 s 2 ns, frame_id "ab\0"; height 2, width 3; one dvs event
-        let mut m = vec![0, 1, 0, 0];
-        m.extend(1u32.to_le_bytes());
-        m.extend(2u32.to_le_bytes());
-        m.extend(3u32.to_le_bytes());
-        m.extend(b"ab\0\0"); // string + 1 pad byte for the u32 after
-        m.extend(2u32.to_le_bytes());
-        m.extend(3u32.to_le_bytes());
-        m.extend(2u32.to_le_bytes()); // two events
-        for (x, s, ns, p) in [(5u16, 7u32, 3000u32, 1u8), (6, 8, 4000, 0)] {
-            while (m.len() - 4) % 2 != 0 {
-                m.push(0xEE);
-            }
-            m.extend(x.to_le_bytes());
-            m.extend(9u16.to_le_bytes());
-            while (m.len() - 4) % 4 != 0 {
-                m.push(0xEE);
-            }
-            m.extend(s.to_le_bytes());
-            m.extend(ns.to_le_bytes());
-            m.push(p);
-        }
-        let mut d = MessageDecoder::new(Kind::Events);
-        let mut out = EventBatch::default();
-        d.decode(&m, Serialization::Cdr, &mut out).unwrap();
-        assert_eq!(out.t, vec![7_000_003, 8_000_004]);
-        assert_eq!(
-            (out.x, out.y, out.p),
-            (vec![5, 6], vec![9, 9], vec![true, false])
-        );
-        assert_eq!((d.width, d.height), (Some(3), Some(2)));
-        // cut anywhere: an error, never a panic
-        for cut in 0..m.len() {
-            let mut out = EventBatch::default();
-            assert!(d.decode(&m[..cut], Serialization::Cdr, &mut out).is_err());
-        }
-    }
-
-    #[test]
-    fn libcaer_clock_loops_within_a_message() {
-        let word = |x: u32, y: u32, p: u32, t: i32| {
-            let mut w = ((x << 17) | (y << 2) | (p << 1) | 1).to_le_bytes().to_vec();
-            w.extend(t.to_le_bytes());
-            w
-        };
-        let bytes = [word(3, 4, 1, i32::MAX - 1), word(5, 6, 0, 2)].concat();
-        let mut out = EventBatch::default();
-        libcaer(&bytes, 1_000_000_000, &mut out);
-        let loop_us = 1i64 << 31;
-        assert_eq!(
-            out.t,
-            vec![1_000_000 + i32::MAX as i64 - 1, 1_000_000 + loop_us + 2]
-        );
-        assert_eq!(
-            (out.x, out.y, out.p),
-            (vec![3, 5], vec![4, 6], vec![true, false])
-        );
-    }
-
-    #[test]
-    fn libcaer_cmp_addresses_and_vectors() {
-        // time high 1 (4096 µs), low 5; x 10; y 20 ON; base y 30 OFF; vector rows 0 and 2
-        let words: [u16; 6] = [1, 0x1005, 0x2000 | 10, 0x3800 | 20, 0x4000 | 30, 0x5005];
-        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
-        let mut c = CaerCmp::default();
-        let mut out = EventBatch::default();
-        c.decode(&bytes, 2_000_000, 640, 480, &mut out);
-        let t = 2_000 + 4096 + 5;
-        assert_eq!(out.t, vec![t, t, t]);
-        assert_eq!(out.x, vec![10, 10, 10]);
-        assert_eq!(out.y, vec![20, 30, 32]);
-        assert_eq!(out.p, vec![true, false, false]);
-        // events outside the sensor are dropped
-        let mut out = EventBatch::default();
-        c.decode(&bytes, 0, 10, 480, &mut out);
-        assert!(out.is_empty());
-    }
-
-    #[test]
-    fn mono_words() {
-        let w: u64 = (1 << 63) | (7u64 << 48) | (9u64 << 32) | 5000;
-        let mut out = EventBatch::default();
-        mono(&w.to_le_bytes(), 1_000_000, &mut out);
-        assert_eq!(
-            (out.t[0], out.x[0], out.y[0], out.p[0]),
-            (1_005, 9, 7, true)
-        );
     }
 }

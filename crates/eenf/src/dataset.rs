@@ -161,11 +161,15 @@ fn random_lamps(rng: &mut rand::rngs::StdRng) -> Vec<Lamp> {
 /// One camera of the `lamp-spot` preset: its class folder, readout and sensor side, and the
 /// range of the lamp's gain in its pool (log-uniform), set so that the flicker line's
 /// prominence spreads over about 6–60, the real recordings' 10–20 among them.
-struct LampSpotClass {
-    name: &'static str,
-    readout: fn() -> Readout,
-    side: u16,
-    gain: (f64, f64),
+pub struct LampSpotClass {
+    /// The class folder.
+    pub name: &'static str,
+    /// The camera's readout.
+    pub readout: fn() -> Readout,
+    /// The sensor's side, pixels.
+    pub side: u16,
+    /// The lamp's gain in its pool, lowest and highest.
+    pub gain: (f64, f64),
 }
 
 /// Whether a preset's manifest scores each recording against its simulated truth (`lamp-spot`:
@@ -176,12 +180,12 @@ pub fn scored_against_truth(preset: &str) -> bool {
 }
 
 /// Recordings per camera of the `lamp-spot` preset.
-const LAMP_SPOT_SEEDS: usize = 10;
+pub const LAMP_SPOT_SEEDS: usize = 10;
 
 /// The cameras of the `lamp-spot` preset: DVS128-like and Prophesee readouts (each event its
 /// own µs timestamp) at 16×16 to 128×128. A smaller sensor has fewer pixels in the pool, so it
 /// needs a brighter pool for the same prominence.
-const LAMP_SPOT_CLASSES: [LampSpotClass; 8] = {
+pub const LAMP_SPOT_CLASSES: [LampSpotClass; 8] = {
     const fn c(
         name: &'static str,
         readout: fn() -> Readout,
@@ -366,54 +370,4 @@ pub fn check_complete(dataset: &Path) -> Result<()> {
         );
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn the_lamp_spot_preset_has_ten_recordings_per_camera() {
-        let spec = DatasetSpec {
-            preset: "lamp-spot".into(),
-            duration_s: None,
-            resolution: None,
-            readout: Readout::dvxplorer(),
-            tz_s: 0.0,
-            seed: 7,
-        };
-        let (plans, duration) = plan_dataset(&spec, (0.0, 6.0 * 3600.0)).unwrap();
-        assert_eq!((plans.len(), duration), (80, 40.0));
-        for c in &LAMP_SPOT_CLASSES {
-            let of: Vec<_> = plans.iter().filter(|p| p.class == c.name).collect();
-            assert_eq!(of.len(), LAMP_SPOT_SEEDS, "{}", c.name);
-            for p in of {
-                let cfg = &p.config;
-                assert_eq!((cfg.width, cfg.height), (c.side, c.side));
-                assert_eq!(cfg.readout, (c.readout)());
-                assert_eq!(cfg.kinds, vec![SceneKind::LampSpot]);
-                let gain = cfg.scene.bulb.as_ref().unwrap().gain;
-                assert!((c.gain.0..=c.gain.1).contains(&gain), "{gain}");
-            }
-        }
-        assert!(scored_against_truth("lamp-spot") && !scored_against_truth("small"));
-    }
-
-    use super::*;
-
-    #[test]
-    fn parses_dataset_names() {
-        let t = recording_start(Path::new("static/dvSave-2022_08_17_16_54_30.aedat4")).unwrap();
-        assert_eq!((t.hour(), t.second_of_hour()), (16, 54 * 60 + 30));
-        assert_eq!(t.date(), "2022_08_17");
-        assert!(recording_start(Path::new("dvSave-2022_13_17_16_54_30.aedat4")).is_none());
-        let r = reference_hour(Path::new("x/2022_08_17_Wed_17_00_00.wav")).unwrap();
-        assert_eq!((r.day(), r.hour(), r.minute()), (17, 17, 0));
-        assert!(reference_hour(Path::new("notes.wav")).is_none());
-        // names made from times read back as those times
-        let t = LocalTime::from_local_seconds(r.local_seconds() + 754);
-        assert_eq!(
-            recording_name(&t, "aedat4"),
-            "dvSave-2022_08_17_17_12_34.aedat4"
-        );
-        assert_eq!(reference_name(&t), "2022_08_17_Wed_17_00_00.wav");
-    }
 }

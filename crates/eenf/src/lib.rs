@@ -28,7 +28,7 @@ pub mod dataset;
 pub mod edits;
 pub mod evaluate;
 pub mod extract;
-mod flac_mask;
+pub mod flac_mask;
 pub mod flicker_map;
 pub mod inspect;
 pub mod locate;

@@ -5,7 +5,7 @@
 
 /// A table inside a FlatBuffer, addressed by its byte position.
 #[derive(Clone, Copy)]
-pub(crate) struct Table<'a> {
+pub struct Table<'a> {
     buf: &'a [u8],
     pos: usize,
     vtable: usize,
@@ -14,7 +14,7 @@ pub(crate) struct Table<'a> {
 
 /// A FlatBuffer access outside the buffer, or an inconsistent offset.
 #[derive(Debug)]
-pub(crate) struct FbError(pub String);
+pub struct FbError(pub String);
 
 type FbResult<T> = Result<T, FbError>;
 
@@ -54,7 +54,7 @@ fn read_i64(buf: &[u8], pos: usize) -> FbResult<i64> {
 impl<'a> Table<'a> {
     /// The root table of a buffer that is not size-prefixed; checks the 4-byte identifier
     /// when one is given.
-    pub(crate) fn root(buf: &'a [u8], ident: Option<&[u8; 4]>) -> FbResult<Self> {
+    pub fn root(buf: &'a [u8], ident: Option<&[u8; 4]>) -> FbResult<Self> {
         if let Some(id) = ident {
             if buf.get(4..8) != Some(&id[..]) {
                 return Err(FbError(format!(
@@ -68,7 +68,7 @@ impl<'a> Table<'a> {
     }
 
     /// The root table of a size-prefixed buffer (u32 size, then the buffer).
-    pub(crate) fn size_prefixed_root(buf: &'a [u8], ident: Option<&[u8; 4]>) -> FbResult<Self> {
+    pub fn size_prefixed_root(buf: &'a [u8], ident: Option<&[u8; 4]>) -> FbResult<Self> {
         let size = read_u32(buf, 0)? as usize;
         if size > buf.len() - 4 {
             return Err(FbError(format!(
@@ -113,7 +113,7 @@ impl<'a> Table<'a> {
     }
 
     /// A scalar i32 field, or `default`.
-    pub(crate) fn i32_field(&self, index: usize, default: i32) -> FbResult<i32> {
+    pub fn i32_field(&self, index: usize, default: i32) -> FbResult<i32> {
         match self.field_pos(index)? {
             Some(p) => Ok(read_u32(self.buf, p)? as i32),
             None => Ok(default),
@@ -121,7 +121,7 @@ impl<'a> Table<'a> {
     }
 
     /// A scalar i64 field, or `default`.
-    pub(crate) fn i64_field(&self, index: usize, default: i64) -> FbResult<i64> {
+    pub fn i64_field(&self, index: usize, default: i64) -> FbResult<i64> {
         match self.field_pos(index)? {
             Some(p) => read_i64(self.buf, p),
             None => Ok(default),
@@ -129,7 +129,7 @@ impl<'a> Table<'a> {
     }
 
     /// The raw bytes of an inline struct field of `size` bytes.
-    pub(crate) fn struct_field(&self, index: usize, size: usize) -> FbResult<Option<&'a [u8]>> {
+    pub fn struct_field(&self, index: usize, size: usize) -> FbResult<Option<&'a [u8]>> {
         match self.field_pos(index)? {
             Some(p) => self
                 .buf
@@ -156,7 +156,7 @@ impl<'a> Table<'a> {
     }
 
     /// A vector of inline structs of `elem_size` bytes: (element count, the bytes of all elements).
-    pub(crate) fn struct_vector(
+    pub fn struct_vector(
         &self,
         index: usize,
         elem_size: usize,
@@ -177,7 +177,7 @@ impl<'a> Table<'a> {
     }
 
     /// A string field.
-    pub(crate) fn str_field(&self, index: usize) -> FbResult<Option<&'a str>> {
+    pub fn str_field(&self, index: usize) -> FbResult<Option<&'a str>> {
         match self.struct_vector(index, 1)? {
             Some((_, bytes)) => std::str::from_utf8(bytes)
                 .map(Some)
@@ -187,7 +187,7 @@ impl<'a> Table<'a> {
     }
 
     /// A vector of tables.
-    pub(crate) fn table_vector(&self, index: usize) -> FbResult<Vec<Table<'a>>> {
+    pub fn table_vector(&self, index: usize) -> FbResult<Vec<Table<'a>>> {
         let Some(v) = self.indirect(index)? else {
             return Ok(Vec::new());
         };
@@ -207,7 +207,7 @@ impl<'a> Table<'a> {
 
 /// Builds a FlatBuffer back to front, as the format intends, for the few shapes AEDAT4 needs:
 /// tables of scalars, offsets and inline structs, byte strings, struct vectors and table vectors.
-pub(crate) struct Builder {
+pub struct Builder {
     /// Bytes written so far, stored reversed in position: `data[cap - len..]` is the buffer tail.
     buf: Vec<u8>,
     /// Fields of the table under construction: (field index, offset from end of the field value).
@@ -218,10 +218,17 @@ pub(crate) struct Builder {
 
 /// A position in the builder, counted from the end of the buffer.
 #[derive(Clone, Copy)]
-pub(crate) struct Offset(usize);
+pub struct Offset(usize);
+
+impl Default for Builder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
 
 impl Builder {
-    pub(crate) fn new() -> Self {
+    /// An empty buffer.
+    pub fn new() -> Self {
         Builder {
             buf: Vec::new(),
             fields: Vec::new(),
@@ -263,7 +270,7 @@ impl Builder {
     }
 
     /// A vector of inline elements given as contiguous bytes (`n` elements of `align` alignment).
-    pub(crate) fn create_struct_vector(&mut self, bytes: &[u8], n: usize, align: usize) -> Offset {
+    pub fn create_struct_vector(&mut self, bytes: &[u8], n: usize, align: usize) -> Offset {
         self.prep(4.max(align), bytes.len());
         self.prep(4, bytes.len());
         self.prepend(bytes);
@@ -272,7 +279,7 @@ impl Builder {
     }
 
     /// A string (NUL-terminated as the format requires).
-    pub(crate) fn create_string(&mut self, s: &str) -> Offset {
+    pub fn create_string(&mut self, s: &str) -> Offset {
         self.prep(4, s.len() + 1);
         self.prepend(&[0]);
         self.prepend(s.as_bytes());
@@ -281,7 +288,7 @@ impl Builder {
     }
 
     /// A vector of table offsets.
-    pub(crate) fn create_offset_vector(&mut self, items: &[Offset]) -> Offset {
+    pub fn create_offset_vector(&mut self, items: &[Offset]) -> Offset {
         self.prep(4, 4 * items.len());
         for it in items.iter().rev() {
             self.prepend_uoffset(*it);
@@ -290,26 +297,27 @@ impl Builder {
         Offset(self.len())
     }
 
-    pub(crate) fn start_table(&mut self) {
+    /// Begins a table; its fields follow, then [`Builder::end_table`].
+    pub fn start_table(&mut self) {
         self.fields.clear();
         self.table_start = self.len();
     }
 
     /// Adds a scalar or inline struct field (bytes in natural little-endian order).
-    pub(crate) fn add_inline(&mut self, index: usize, bytes: &[u8], align: usize) {
+    pub fn add_inline(&mut self, index: usize, bytes: &[u8], align: usize) {
         self.prep(align, bytes.len());
         self.prepend(bytes);
         self.fields.push((index, self.len()));
     }
 
     /// Adds an offset field.
-    pub(crate) fn add_offset(&mut self, index: usize, target: Offset) {
+    pub fn add_offset(&mut self, index: usize, target: Offset) {
         self.prepend_uoffset(target);
         self.fields.push((index, self.len()));
     }
 
     /// Finishes the table and writes its vtable in front of it.
-    pub(crate) fn end_table(&mut self) -> Offset {
+    pub fn end_table(&mut self) -> Offset {
         // soffset placeholder, patched below
         self.prep(4, 0);
         self.prepend(&[0, 0, 0, 0]);
@@ -338,7 +346,7 @@ impl Builder {
 
     /// Finishes the buffer with `root`, a 4-byte identifier and a u32 size prefix, returning the
     /// bytes in forward order.
-    pub(crate) fn finish_size_prefixed(mut self, root: Offset, ident: &[u8; 4]) -> Vec<u8> {
+    pub fn finish_size_prefixed(mut self, root: Offset, ident: &[u8; 4]) -> Vec<u8> {
         let align = self.min_align.max(4);
         self.prep(align, 12);
         self.prepend(ident);
@@ -350,50 +358,12 @@ impl Builder {
     }
 
     /// Finishes the buffer with `root` and a 4-byte identifier, without a size prefix.
-    pub(crate) fn finish(mut self, root: Offset, ident: &[u8; 4]) -> Vec<u8> {
+    pub fn finish(mut self, root: Offset, ident: &[u8; 4]) -> Vec<u8> {
         let align = self.min_align.max(4);
         self.prep(align, 8);
         self.prepend(ident);
         self.prepend_uoffset(root);
         self.buf.reverse();
         self.buf
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn builder_output_reads_back() {
-        let mut b = Builder::new();
-        let s = b.create_string("hello");
-        let items: Vec<u8> = (0u8..32).collect();
-        let v = b.create_struct_vector(&items, 2, 8);
-        b.start_table();
-        b.add_inline(1, &(-7i64).to_le_bytes(), 8);
-        b.add_offset(2, s);
-        b.add_offset(0, v);
-        b.add_inline(3, &5i32.to_le_bytes(), 4);
-        let t = b.end_table();
-        let buf = b.finish_size_prefixed(t, b"TEST");
-        let table = Table::size_prefixed_root(&buf, Some(b"TEST")).unwrap();
-        assert_eq!(table.i64_field(1, 0).unwrap(), -7);
-        assert_eq!(table.i32_field(3, 0).unwrap(), 5);
-        assert_eq!(table.i32_field(9, 42).unwrap(), 42);
-        assert_eq!(table.str_field(2).unwrap(), Some("hello"));
-        let (n, bytes) = table.struct_vector(0, 16).unwrap().unwrap();
-        assert_eq!(n, 2);
-        assert_eq!(bytes, &items[..]);
-        // the struct vector body is 8-aligned relative to the start of the whole buffer
-        let start = bytes.as_ptr() as usize - buf.as_ptr() as usize;
-        assert_eq!(start % 8, 0);
-    }
-
-    #[test]
-    fn corrupt_offsets_are_errors() {
-        let buf = [0xffu8; 16];
-        assert!(Table::root(&buf, None).is_err());
-        assert!(Table::size_prefixed_root(&[1, 0], None).is_err());
     }
 }

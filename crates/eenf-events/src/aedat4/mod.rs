@@ -4,8 +4,8 @@
 //! `{i32 stream, i32 size, body}` whose bodies are compressed size-prefixed FlatBuffers, and an
 //! optional FileDataTable at the end.
 
-mod flatbuf;
-mod lz4;
+pub mod flatbuf;
+pub mod lz4;
 mod writer;
 
 use std::collections::VecDeque;
@@ -113,7 +113,7 @@ impl std::str::FromStr for Compression {
 }
 
 /// Streams declared in the IOHeader's XML `infoNode`: (id, type identifier, width, height, source).
-fn parse_streams(xml: &str) -> Vec<StreamDesc> {
+pub fn parse_streams(xml: &str) -> Vec<StreamDesc> {
     // A tolerant scan instead of an XML parser: nodes are entered and left, and each `attr`
     // belongs to the innermost enclosing node whose name is a stream number. Node paths differ
     // between writers, so they are not used.
@@ -697,38 +697,5 @@ impl EventReader for Aedat4Reader {
             }
             self.fill()?;
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn parses_stream_list_from_dv_xml() {
-        let xml = r#"<dv version="2.0"><node name="outInfo" path="/x/">
-            <node name="0" path="/x/0/"><attr key="typeIdentifier" type="string">EVTS</attr>
-              <node name="info" path="/x/0/info/"><attr key="sizeX" type="int">640</attr>
-              <attr key="sizeY" type="int">480</attr><attr key="source" type="string">DVX</attr></node>
-            </node>
-            <node name="2" path="/x/2/"><attr key="typeIdentifier" type="string">IMUS</attr></node>
-            </node></dv>"#;
-        let s = parse_streams(xml);
-        assert_eq!(s.len(), 2);
-        assert_eq!((s[0].id, s[0].kind.as_str()), (0, "EVTS"));
-        assert_eq!((s[0].width, s[0].height), (Some(640), Some(480)));
-        assert_eq!(s[0].source.as_deref(), Some("DVX"));
-        assert_eq!((s[1].id, s[1].kind.as_str()), (2, "IMUS"));
-    }
-
-    #[test]
-    fn compression_names_round_trip() {
-        for code in 0..5 {
-            let c = Compression::from_code(code).unwrap();
-            assert_eq!(c.name().parse::<Compression>(), Ok(c));
-            assert_eq!(c.code(), code);
-        }
-        assert_eq!("lz4-high".parse::<Compression>(), Ok(Compression::Lz4High));
-        assert_eq!(Compression::from_code(7), None);
     }
 }
