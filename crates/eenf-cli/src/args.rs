@@ -310,10 +310,10 @@ impl TraceOutputArgs {
         if let Some(p) = &self.plot {
             let title = format!(
                 "{}: ENF, and each band's estimate (the band taken per {} s below)",
-                crate::plot::title_name(source),
+                eenf_figures::title_name(source),
                 trace.segment_s().unwrap_or(0.0)
             );
-            crate::plot::plot_extraction(p, &title, trace)?;
+            eenf_figures::plot_extraction(p, &title, trace)?;
         }
         Ok(())
     }

@@ -1,6 +1,7 @@
 //! # eenf-cli
 //!
-//! The `eenf` command: its flags, its commands, its progress bars, figures and printing. Every
+//! The `eenf` command: its flags, its commands, its progress bars and printing; its figures
+//! come from `eenf-figures`. Every
 //! command parses its flags into the library's types ([`args`]), calls the library (`eenf`),
 //! and prints or draws what comes back ([`commands`]); `main.rs` only dispatches. The Python
 //! package reads the same option sets, so that keyword arguments have the flags' names,
@@ -13,6 +14,4 @@ pub mod args;
 // flattens carry their own documentation in `args`.
 #[allow(missing_docs)]
 pub mod commands;
-pub mod figures;
-pub mod plot;
 pub mod terminal;

@@ -165,7 +165,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         eprintln!("traces in {}", dir.display());
     }
     if let Some(dir) = &a.plots {
-        let n = crate::figures::write_plots(dir, &recs, &runs, &methods, &progress)?;
+        let n = eenf_figures::write_plots(dir, &recs, &runs, &methods, &progress)?;
         eprintln!("{n} figures in {}", dir.display());
     }
     if let Some(p) = &a.report {

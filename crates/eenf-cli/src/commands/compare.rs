@@ -2,13 +2,13 @@
 
 use std::path::PathBuf;
 
-use crate::plot::plot_comparison;
 use anyhow::Result;
 use eenf::evaluate::compare_trace;
 use eenf::progress::Progress;
 use eenf::trace::Trace;
 use eenf_core::Nominal;
 use eenf_dsp::{EnfParams, PeakMethod};
+use eenf_figures::plot_comparison;
 
 use crate::args::one_of;
 
@@ -68,7 +68,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     if let Some(p) = &a.plot {
         let title = format!(
             "{} vs {}: CC {:.4}, MAE {:.2} mHz",
-            crate::plot::title_name(&a.estimate),
+            eenf_figures::title_name(&a.estimate),
             a.reference
                 .file_name()
                 .unwrap_or_default()

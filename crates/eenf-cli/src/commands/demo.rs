@@ -2,7 +2,6 @@
 
 use std::path::PathBuf;
 
-use crate::plot::{plot_comparison, plot_extraction};
 use anyhow::{Context, Result};
 use eenf::evaluate::compare_trace;
 use eenf::extract::{extract_file, ExtractOptions};
@@ -12,6 +11,7 @@ use eenf::simulation::{simulate_recording, Recipe};
 use eenf::trace::Trace;
 use eenf_core::Nominal;
 use eenf_dsp::EnfParams;
+use eenf_figures::{plot_comparison, plot_extraction};
 use eenf_sim::{SceneKind, SimConfig};
 
 /// Arguments of `eenf demo`.

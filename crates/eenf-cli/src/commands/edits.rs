@@ -44,8 +44,8 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         }
     }
     if let Some(plot) = &a.plot {
-        let title = format!("{}: {}", crate::plot::title_name(&a.file), report.verdict);
-        crate::plot::plot_edits(plot, &title, &report)?;
+        let title = format!("{}: {}", eenf_figures::title_name(&a.file), report.verdict);
+        eenf_figures::plot_edits(plot, &title, &report)?;
         crate::terminal::announce("plot", plot);
     }
     let lines: Vec<String> = report.lines_hz.iter().map(|f| format!("{f:.0}")).collect();

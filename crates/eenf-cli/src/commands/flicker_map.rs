@@ -2,10 +2,10 @@
 
 use std::path::PathBuf;
 
-use crate::plot::plot_flicker_map;
 use anyhow::Result;
 use eenf::flicker_map::{flicker_map, MAP_SECONDS};
 use eenf::progress::Progress;
+use eenf_figures::plot_flicker_map;
 
 use crate::args::InputArgs;
 
@@ -42,11 +42,11 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let title = match map.whole {
         Some(l) => format!(
             "{}: flicker at {:.3} Hz, {:.0} dB over the noise; it stands out in {share:.0} % of the tiles",
-            crate::plot::title_name(&a.file),
+            eenf_figures::title_name(&a.file),
             l.hz,
             l.db()
         ),
-        None => format!("{}: no flicker line measured", crate::plot::title_name(&a.file)),
+        None => format!("{}: no flicker line measured", eenf_figures::title_name(&a.file)),
     };
     let picture = match (&a.output, a.json) {
         (Some(p), _) => Some(p.clone()),

@@ -2,13 +2,13 @@
 
 use std::path::PathBuf;
 
-use crate::plot::plot_comparison;
 use anyhow::Result;
 use eenf::locate::locate;
 use eenf::progress::Progress;
 use eenf::reference::ReferenceSeries;
 use eenf::trace::Trace;
 use eenf_dsp::resample::resample;
+use eenf_figures::plot_comparison;
 
 use crate::args::MatchArgs;
 
@@ -71,7 +71,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             p,
             &format!(
                 "{} at {}: CC {:.4}, p {:.1e}",
-                crate::plot::title_name(&a.trace),
+                eenf_figures::title_name(&a.trace),
                 when(r, c.offset),
                 c.agreement.cc,
                 c.p_value

@@ -9,9 +9,7 @@ use eenf::bench::report::stem;
 use eenf::bench::{paper_value, Method, Outcome, Recording, Run};
 use eenf::progress::Progress;
 
-use crate::plot::{
-    plot_extraction, plot_methods, plot_spectrogram, plot_summary, Series, SummaryBar,
-};
+use crate::{plot_extraction, plot_methods, plot_spectrogram, plot_summary, Series, SummaryBar};
 
 /// Writes each figure as PNG and SVG; returns how many files.
 pub fn write_plots(

@@ -1,0 +1,29 @@
+//! # eenf-figures
+//!
+//! The figures of eenf, drawn with plotters as PNG or SVG (chosen by the file's extension) and
+//! written whole or not at all: an estimate against its reference with the error underneath
+//! ([`plot_comparison`], [`plot_methods`]), a trace's harmonics with the one chosen per segment
+//! ([`plot_extraction`]), spectrograms, a benchmark's summary, the flicker map of an event
+//! recording and the hum's phase with the edits found in it. The command line draws them; the
+//! Python package and a page are to draw the same ones, so they live here rather than in a front
+//! end.
+
+#![forbid(unsafe_code)]
+
+mod bench;
+mod comparison;
+mod draw;
+mod edits;
+mod extraction;
+mod flicker_map;
+mod spectrogram;
+mod summary;
+
+pub use bench::write_plots;
+pub use comparison::{plot_comparison, plot_methods, Series};
+pub use draw::title_name;
+pub use edits::plot_edits;
+pub use extraction::plot_extraction;
+pub use flicker_map::plot_flicker_map;
+pub use spectrogram::plot_spectrogram;
+pub use summary::{plot_summary, SummaryBar};
