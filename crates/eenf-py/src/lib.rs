@@ -539,6 +539,20 @@ fn video(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<PyTrace> 
     traced(py.detach(|| eenf::video::trace_video(&path, &opts, &Progress::hidden())))
 }
 
+/// Draws `trace` into `path` (`.png` or `.svg`) as `eenf extract --plot` does: its ENF, each
+/// harmonic's and the one chosen in each segment, titled `title`. The GIL is released.
+#[pyfunction]
+fn plot_trace(
+    py: Python<'_>,
+    trace: PyRef<'_, PyTrace>,
+    path: PathBuf,
+    title: String,
+) -> PyResult<()> {
+    let t = trace.0.clone();
+    py.detach(|| eenf_figures::plot_extraction(&path, &title, &t))
+        .map_err(py_err)
+}
+
 /// A reference for `compare`: a trace at hand, or a file (trace, WAV, folder of hourly WAVs).
 #[derive(FromPyObject)]
 enum ReferenceIn<'py> {
@@ -588,13 +602,11 @@ fn compare(
         }),
     }
     .map_err(py_err)?;
-    let m = c.agreement;
-    Ok(serde_json::json!({
-        "cc": m.cc, "mae_hz": m.mae_hz, "rmse_hz": m.rmse_hz, "max_err_hz": m.max_err_hz,
-        "seconds": m.n, "offset_s": offset_s, "time_s": c.time_s, "estimate": c.estimate,
-        "reference": c.reference,
-    })
-    .to_string())
+    let mut v = c.summary_json(offset_s);
+    v["time_s"] = serde_json::json!(c.time_s);
+    v["estimate"] = serde_json::json!(c.estimate);
+    v["reference"] = serde_json::json!(c.reference);
+    Ok(v.to_string())
 }
 
 /// `eenf match`: where a trace fits in long references, as `eenf match --json` prints it.
@@ -789,6 +801,7 @@ fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reference_samples, m)?)?;
     m.add_function(wrap_pyfunction!(video, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(plot_trace, m)?)?;
     m.add_function(wrap_pyfunction!(match_trace, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(refdb_build, m)?)?;

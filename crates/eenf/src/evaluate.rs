@@ -146,6 +146,20 @@ pub struct Comparison {
     pub nominal_hz: Option<f64>,
 }
 
+impl Comparison {
+    /// The agreement as `eenf compare --json` and Python's `compare` report it: `cc`,
+    /// `mae_hz`, `rmse_hz`, `max_err_hz` (Hz), `seconds` compared, and the `offset_s` that was
+    /// added to the estimate's times. Each front end adds what it has besides (file names, the
+    /// aligned values).
+    pub fn summary_json(&self, offset_s: f64) -> serde_json::Value {
+        let m = &self.agreement;
+        serde_json::json!({
+            "cc": m.cc, "mae_hz": m.mae_hz, "rmse_hz": m.rmse_hz, "max_err_hz": m.max_err_hz,
+            "seconds": m.n, "offset_s": offset_s,
+        })
+    }
+}
+
 /// Compares the estimate (`time_s`, `enf_hz`; named `what` in errors) with `reference`,
 /// shifting estimate times by `offset_s`. A WAV reference is traced with `params` (its peak
 /// method, window and step).

@@ -80,11 +80,10 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         crate::terminal::announce("plot", p);
     }
     if a.json {
-        let v = serde_json::json!({
-            "estimate": a.estimate, "reference": a.reference, "offset_s": a.offset_s,
-            "seconds": m.n, "cc": m.cc, "mae_hz": m.mae_hz, "rmse_hz": m.rmse_hz,
-            "max_err_hz": m.max_err_hz, "plot": a.plot,
-        });
+        let mut v = c.summary_json(a.offset_s);
+        v["estimate"] = serde_json::json!(a.estimate);
+        v["reference"] = serde_json::json!(a.reference);
+        v["plot"] = serde_json::json!(a.plot);
         outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         outln!("estimate   {}", a.estimate.display());

@@ -339,6 +339,16 @@ class Trace:
         self._native.save(p)
         return None
 
+    def save_figure(self, path: PathLike, title: Optional[str] = None) -> None:
+        """Draws the trace into ``path`` (``.png`` or ``.svg``, by its extension) as
+        ``eenf extract --plot`` does: the ENF, each harmonic's estimates and the harmonic chosen
+        in each segment, on axes that fit the ENF. The figure is written whole or not at all;
+        ``title`` defaults to the traced file's name."""
+        if title is None:
+            f = self.meta.get("file")
+            title = os.path.basename(f) if f else "ENF trace"
+        _eenf.plot_trace(self._native, os.fspath(path), title)
+
     def plot(
         self, ax: Any = None, *, label: str = "ENF", harmonics: bool = True, **style: Any
     ) -> Any:
