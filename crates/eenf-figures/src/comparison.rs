@@ -39,18 +39,15 @@ fn comparison<DB: DrawingBackend>(
     let mut c = enf_panel(&upper, x, y)?;
     // the reference: the longest of the series' aligned references (they are the same signal)
     if let Some(r) = series.iter().max_by_key(|s| s.time_s.len()) {
-        c.draw_series(LineSeries::new(
-            std::iter::empty::<(f64, f64)>(),
-            BLACK.stroke_width(2),
-        ))
-        .map_err(e)?
-        .label("reference")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-        // a gap breaks the line rather than being drawn (plotters has no missing value)
-        for run in runs(r.time_s, r.reference) {
-            c.draw_series(LineSeries::new(run, BLACK.stroke_width(2)))
-                .map_err(e)?;
-        }
+        let style = BLACK.stroke_width(2);
+        labelled_runs(
+            &mut c,
+            r.time_s,
+            r.reference,
+            style,
+            "reference".into(),
+            style,
+        )?;
     }
     let colour = |s: &Series| {
         if series.len() == 1 {
@@ -60,18 +57,8 @@ fn comparison<DB: DrawingBackend>(
         }
     };
     for s in series {
-        let col = colour(s);
-        c.draw_series(LineSeries::new(
-            std::iter::empty::<(f64, f64)>(),
-            col.stroke_width(2),
-        ))
-        .map_err(e)?
-        .label(s.label.clone())
-        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col.stroke_width(2)));
-        for run in runs(s.time_s, s.estimate) {
-            c.draw_series(LineSeries::new(run, col.stroke_width(2)))
-                .map_err(e)?;
-        }
+        let style = colour(s).stroke_width(2);
+        labelled_runs(&mut c, s.time_s, s.estimate, style, s.label.clone(), style)?;
     }
     legend(&mut c)?;
     let errors: Vec<Vec<f64>> = series

@@ -127,6 +127,26 @@ pub(crate) fn runs(t: &[f64], v: &[f64]) -> Vec<Vec<(f64, f64)>> {
     out
 }
 
+/// Draws `v` over `t` as a line in `style` that gaps break (plotters has no missing value), with
+/// one legend entry `label` in `legend_style`: there even when no value is drawn.
+pub(crate) fn labelled_runs<DB: DrawingBackend>(
+    c: &mut Panel<'_, DB>,
+    t: &[f64],
+    v: &[f64],
+    style: ShapeStyle,
+    label: String,
+    legend_style: ShapeStyle,
+) -> Result<()> {
+    c.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+        .map_err(e)?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], legend_style));
+    for run in runs(t, v) {
+        c.draw_series(LineSeries::new(run, style)).map_err(e)?;
+    }
+    Ok(())
+}
+
 /// A tick label with `digits` decimals, never `-0.00`.
 pub(crate) fn tick(v: f64, digits: usize) -> String {
     let text = format!("{v:.digits$}");

@@ -58,38 +58,19 @@ fn extraction<DB: DrawingBackend>(
                 divisor(h)
             ),
         };
-        let mut first = true;
-        for run in runs(t, &shown) {
-            let drawn = c
-                .draw_series(LineSeries::new(run, col.mix(0.45).stroke_width(1)))
-                .map_err(e)?;
-            if std::mem::take(&mut first) {
-                drawn.label(label.clone()).legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 20, y)], col.mix(0.45).stroke_width(2))
-                });
-            }
-        }
-        if first {
-            // every estimate of the band off the scale (or none): named all the same
-            c.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
-                .map_err(e)?
-                .label(label)
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 20, y)], col.mix(0.45).stroke_width(2))
-                });
-        }
+        // a band with every estimate off the scale (or none) is named all the same
+        let (line, key) = (col.mix(0.45).stroke_width(1), col.mix(0.45).stroke_width(2));
+        labelled_runs(&mut c, t, &shown, line, label, key)?;
     }
-    let mut first = true;
-    for run in runs(t, &tr.enf_hz) {
-        let drawn = c
-            .draw_series(LineSeries::new(run, BLACK.stroke_width(3)))
-            .map_err(e)?;
-        if std::mem::take(&mut first) {
-            drawn
-                .label("ENF (the selected band's)")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(3)));
-        }
-    }
+    let style = BLACK.stroke_width(3);
+    labelled_runs(
+        &mut c,
+        t,
+        &tr.enf_hz,
+        style,
+        "ENF (the selected band's)".into(),
+        style,
+    )?;
     let noise: Vec<(f64, f64)> = tr
         .at_noise_level()
         .into_iter()
