@@ -5,20 +5,19 @@
 use std::path::PathBuf;
 use std::str::FromStr;
 
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
-use eenf::archive::{ArchiveFormat, ArchiveOptions, DateOrder, ValueUnit};
+use eenf::archive::{ArchiveFormat, DateOrder, ValueUnit};
 use eenf::edits::{EditInput, EditOptions, EditParams};
 use eenf::extract::ExtractOptions;
-use eenf::simulation::{EnfSource, Recipe};
+use eenf::options::{self, limits};
+use eenf::simulation::Recipe;
 use eenf::time::Zone;
 use eenf_core::{defaults, Nominal};
 use eenf_dsp::{EnfParams, HarmonicSelection, PeakMethod, SamplingMethod};
 use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;
-use eenf_sim::SimConfig;
-use eenf_sim::{Lamp, SceneKind};
-use eenf_video::{IdleRows, RowSampling, SceneRemoval, VideoOptions};
+use eenf_video::{RowSampling, SceneRemoval, VideoOptions};
 
 /// A clap parser for a library enum: one of `names`, parsed by the enum's `FromStr`.
 pub fn one_of<T>(names: &'static [&'static str]) -> impl TypedValueParser<Value = T>
@@ -30,7 +29,9 @@ where
 
 /// A number in `lo..=hi`, for flags read from the user: anything else (NaN, inf, out of range)
 /// is a one-line error naming the range, before any work or allocation is sized by it.
-pub fn number_in(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync {
+pub fn number_in(
+    (lo, hi): (f64, f64),
+) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync {
     move |s: &str| {
         let v: f64 = s
             .trim()
@@ -46,8 +47,7 @@ pub fn number_in(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clo
 
 /// A whole number in `lo..=hi` (see [`number_in`]).
 pub fn count_in(
-    lo: usize,
-    hi: usize,
+    (lo, hi): (usize, usize),
 ) -> impl Fn(&str) -> Result<usize, String> + Clone + Send + Sync {
     move |s: &str| {
         let v: usize = s
@@ -75,13 +75,13 @@ pub struct TrackerArgs {
     pub peak: PeakMethod,
     /// STFT window length, s. Default: 16 (the paper's); a recording shorter than that is
     /// traced with a window that fits it, and `audio` lengthens it for weak hum.
-    #[arg(long, value_parser = number_in(0.01, 3600.0))]
+    #[arg(long, value_parser = number_in(limits::WINDOW_S))]
     pub window: Option<f64>,
     /// STFT step, s (one estimate per step).
-    #[arg(long, default_value_t = defaults::STEP_S, value_parser = number_in(0.001, 3600.0))]
+    #[arg(long, default_value_t = defaults::STEP_S, value_parser = number_in(limits::STEP_S))]
     pub step: f64,
     /// Half width of the search band (and band-pass) around each line, Hz.
-    #[arg(long, default_value_t = defaults::HALF_BAND_HZ, value_parser = number_in(0.01, 20.0))]
+    #[arg(long, default_value_t = defaults::HALF_BAND_HZ, value_parser = number_in(limits::HALF_BAND_HZ))]
     pub half_band: f64,
 }
 
@@ -102,22 +102,22 @@ pub struct MethodArgs {
     /// Sampling interval Δt, µs. Default: the paper's 1000 for scan groups (paper, authors),
     /// 100 for the vote or sum over per-event stamps (block, sum), whose flicker harmonics
     /// would alias at 1 ms.
-    #[arg(long, value_parser = clap::value_parser!(i64).range(10..=1_000_000))]
+    #[arg(long, value_parser = clap::value_parser!(i64).range(limits::DT_US.0 as i64..=limits::DT_US.1 as i64))]
     pub dt_us: Option<i64>,
     /// Number of flicker harmonics M (bands at 2m·f0, m = 1..M; those above Nyquist skipped).
-    #[arg(long, default_value_t = defaults::HARMONICS as u32, value_parser = clap::value_parser!(u32).range(1..=16))]
+    #[arg(long, default_value_t = defaults::HARMONICS as u32, value_parser = clap::value_parser!(u32).range(limits::HARMONICS.0 as i64..=limits::HARMONICS.1 as i64))]
     pub harmonics: u32,
     /// Butterworth order of the band-pass prototype.
-    #[arg(long, default_value_t = defaults::FILTER_ORDER as u32, value_parser = clap::value_parser!(u32).range(1..=8))]
+    #[arg(long, default_value_t = defaults::FILTER_ORDER as u32, value_parser = clap::value_parser!(u32).range(limits::FILTER_ORDER.0 as i64..=limits::FILTER_ORDER.1 as i64))]
     pub filter_order: u32,
     /// Running-median length of the outlier correction (0 or 1 disables it).
-    #[arg(long, default_value_t = defaults::MEDIAN_LEN, value_parser = count_in(0, 10_001))]
+    #[arg(long, default_value_t = defaults::MEDIAN_LEN, value_parser = count_in(limits::MEDIAN_LEN))]
     pub median_len: usize,
     /// Outlier threshold on the 2f0 scale, Hz.
-    #[arg(long, default_value_t = defaults::MEDIAN_THRESHOLD_HZ, value_parser = number_in(0.0, 10.0))]
+    #[arg(long, default_value_t = defaults::MEDIAN_THRESHOLD_HZ, value_parser = number_in(limits::MEDIAN_THRESHOLD_HZ))]
     pub median_threshold: f64,
     /// Harmonic-selection segment length, in estimates.
-    #[arg(long, default_value_t = defaults::SEGMENT_LEN, value_parser = count_in(1, 100_000))]
+    #[arg(long, default_value_t = defaults::SEGMENT_LEN, value_parser = count_in(limits::SEGMENT))]
     pub segment: usize,
     /// Harmonic-selection rule: consensus (the smoothest among harmonics that agree with
     /// another one, within --agree-hz), smoothest (the paper: the smoothest harmonic trace per
@@ -127,10 +127,10 @@ pub struct MethodArgs {
     #[arg(long, default_value = "consensus", value_parser = one_of::<HarmonicSelection>(&HarmonicSelection::NAMES))]
     pub selection: HarmonicSelection,
     /// Largest step of the journal rule's 2f0 trace between estimates, Hz (on the ENF scale).
-    #[arg(long, default_value_t = HarmonicSelection::DEFAULT_JUMP_HZ, value_parser = number_in(0.0, 10.0))]
+    #[arg(long, default_value_t = HarmonicSelection::DEFAULT_JUMP_HZ, value_parser = number_in(limits::SELECTION_HZ))]
     pub jump_hz: f64,
     /// Agreement tolerance of the consensus rule, Hz (on the ENF scale).
-    #[arg(long, default_value_t = HarmonicSelection::DEFAULT_AGREE_HZ, value_parser = number_in(0.0, 10.0))]
+    #[arg(long, default_value_t = HarmonicSelection::DEFAULT_AGREE_HZ, value_parser = number_in(limits::SELECTION_HZ))]
     pub agree_hz: f64,
     /// Trace every pixel. By default, when events are stamped one by one (DVS128, DAVIS,
     /// Prophesee), only the tiles of pixels whose flicker stands out are traced (the
@@ -168,58 +168,64 @@ pub struct InputArgs {
 }
 
 impl InputArgs {
-    /// The reader options.
-    pub fn options(&self) -> eenf_events::OpenOptions {
-        eenf_events::OpenOptions {
+    /// The library's option set.
+    pub fn settings(&self) -> options::InputSettings {
+        options::InputSettings {
             chip: self.chip.clone(),
             camera: self.camera,
             strict: self.strict,
-            // NaN and negatives: no step is allowed; huge values: any is
-            max_gap_us: Some((self.max_gap * 1e6).clamp(0.0, i64::MAX as f64) as i64),
+            max_gap: self.max_gap,
             topic: self.topic.clone(),
         }
+    }
+
+    /// The reader options.
+    pub fn options(&self) -> eenf_events::OpenOptions {
+        self.settings().open_options()
     }
 }
 
 impl TrackerArgs {
+    /// The library's option set.
+    pub fn settings(&self) -> options::TrackerSettings {
+        options::TrackerSettings {
+            nominal: self.nominal,
+            peak: self.peak,
+            window: self.window,
+            step: self.step,
+            half_band: self.half_band,
+        }
+    }
+
     /// The tracker part of the parameters.
     pub fn params(&self) -> Result<EnfParams> {
-        let window = self.window.unwrap_or(EnfParams::default().window_s);
-        if !(window > 0.0 && self.step > 0.0 && self.half_band > 0.0) {
-            bail!("--window, --step and --half-band must be positive");
-        }
-        Ok(EnfParams {
-            peak: self.peak,
-            window_s: window,
-            step_s: self.step,
-            half_band_hz: self.half_band,
-            ..EnfParams::default()
-        })
+        Ok(self.settings().params()?)
     }
 }
 
 impl MethodArgs {
-    /// The options of the extraction.
-    pub fn options(&self) -> Result<ExtractOptions> {
-        let mut params = self.tracker.params()?;
-        params.harmonics = self.harmonics as usize;
-        params.filter_order = self.filter_order as usize;
-        params.median_len = self.median_len;
-        params.median_threshold_hz = self.median_threshold;
-        params.segment_len = self.segment.max(1);
-        params.selection = match self.selection {
-            HarmonicSelection::Consensus(_) => HarmonicSelection::Consensus(self.agree_hz),
-            HarmonicSelection::Journal(_) => HarmonicSelection::Journal(self.jump_hz),
-            other => other,
-        };
-        Ok(ExtractOptions {
+    /// The library's option set.
+    pub fn settings(&self) -> options::ExtractSettings {
+        options::ExtractSettings {
+            tracker: self.tracker.settings(),
             sampling: self.sampling,
             dt_us: self.dt_us,
-            nominal: self.tracker.nominal,
-            params,
-            open: self.input.options(),
-            flicker_tiles: !self.all_pixels,
-        })
+            harmonics: self.harmonics,
+            filter_order: self.filter_order,
+            median_len: self.median_len,
+            median_threshold: self.median_threshold,
+            segment: self.segment,
+            selection: self.selection,
+            jump_hz: self.jump_hz,
+            agree_hz: self.agree_hz,
+            all_pixels: self.all_pixels,
+            input: self.input.settings(),
+        }
+    }
+
+    /// The options of the extraction.
+    pub fn options(&self) -> Result<ExtractOptions> {
+        Ok(self.settings().options()?)
     }
 }
 
@@ -236,24 +242,21 @@ pub struct EventOutputArgs {
 }
 
 impl EventOutputArgs {
+    /// The library's option set.
+    pub fn settings(&self) -> options::EventOutputSettings {
+        options::EventOutputSettings {
+            format: self.format,
+            compression: self.compression,
+        }
+    }
+
     /// The format for `path`: `--format`, else its extension, else `fallback`.
     pub fn format_for(
         &self,
         path: &std::path::Path,
         fallback: Option<OutputFormat>,
     ) -> Result<OutputFormat> {
-        let f = match self.format {
-            Some(f) => f,
-            None => OutputFormat::from_extension(path, self.compression)
-                .or(fallback)
-                .with_context(|| {
-                    format!(
-                        "{}: cannot tell the output format from the name; pass --format aedat4|evt2|evt3|dat|text",
-                        path.display()
-                    )
-                })?,
-        };
-        Ok(f.with_compression(self.compression))
+        Ok(self.settings().format_for(path, fallback)?)
     }
 }
 
@@ -268,7 +271,7 @@ pub struct VideoArgs {
     #[arg(long)]
     pub video: Option<String>,
     /// Scale the videos' frames by this factor (0..1], for speed.
-    #[arg(long, default_value_t = 1.0, value_parser = number_in(0.001, 1.0))]
+    #[arg(long, default_value_t = 1.0, value_parser = number_in(limits::VIDEO_SCALE))]
     pub video_scale: f64,
     /// Also encode each video as MP4 (H.264 at the camera's CRF: 28 webcam, 20 phone) with
     /// ffmpeg, as the cameras' own pipelines do.
@@ -277,12 +280,18 @@ pub struct VideoArgs {
 }
 
 impl VideoArgs {
+    /// The library's option set.
+    pub fn settings(&self) -> options::VideoRenderSettings {
+        options::VideoRenderSettings {
+            video: self.video.clone(),
+            video_scale: self.video_scale,
+            mp4: self.mp4,
+        }
+    }
+
     /// The cameras asked for (none without `--video`).
     pub fn cameras(&self) -> Result<Vec<eenf_sim::CameraConfig>> {
-        match &self.video {
-            Some(list) => eenf::simulation::parse_cameras(list, self.video_scale),
-            None => Ok(Vec::new()),
-        }
+        Ok(self.settings().cameras()?)
     }
 }
 
@@ -346,64 +355,6 @@ impl TraceOutputArgs {
     }
 }
 
-/// WxH → (W, H).
-pub fn parse_resolution(s: &str) -> Result<(u16, u16)> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .with_context(|| format!("--resolution {s:?}: expected WxH, e.g. 320x240"))?;
-    let w: u16 = w
-        .trim()
-        .parse()
-        .with_context(|| format!("--resolution {s:?}: bad width"))?;
-    let h: u16 = h
-        .trim()
-        .parse()
-        .with_context(|| format!("--resolution {s:?}: bad height"))?;
-    if w == 0 || h == 0 || w > 4096 || h > 4096 {
-        bail!("--resolution {s:?}: width and height must be 1..4096");
-    }
-    Ok((w, h))
-}
-
-/// `static,dynamic-object` → kinds.
-pub fn parse_scene(s: &str) -> Result<Vec<SceneKind>> {
-    s.split(',')
-        .map(|k| {
-            SceneKind::parse(k).with_context(|| {
-                format!(
-                    "--scene {k:?}: expected static, dynamic-object, dynamic-camera, extreme-dim, \
-                     extreme-bright or lamp-spot"
-                )
-            })
-        })
-        .collect()
-}
-
-/// `led,fluorescent@120` → lamps.
-pub fn parse_lamps(s: &str) -> Result<Vec<Lamp>> {
-    let lamps: Vec<Lamp> = s
-        .split(',')
-        .map(|l| {
-            Lamp::parse(l).with_context(|| {
-                format!(
-                    "--lamp {l:?}: expected KIND[@PHASE_DEG][*SHARE] with KIND incandescent, \
-                     fluorescent, led or sinusoid"
-                )
-            })
-        })
-        .collect::<Result<_>>()?;
-    if lamps.len() > eenf_sim::MAX_LAMPS {
-        bail!("--lamp: at most {} lamps", eenf_sim::MAX_LAMPS);
-    }
-    Ok(lamps)
-}
-
-/// `--readout` → the sensor readout.
-pub fn parse_readout(s: &str) -> Result<eenf_sim::Readout> {
-    eenf_sim::Readout::named(s)
-        .with_context(|| format!("--readout {s:?}: expected dvxplorer, prophesee or dvs128"))
-}
-
 /// How a recording's sound is read and tracked (`reference`).
 #[derive(Debug, Clone, clap::Args)]
 pub struct AudioArgs {
@@ -419,20 +370,22 @@ pub struct AudioArgs {
 }
 
 impl AudioArgs {
+    /// The library's option set.
+    pub fn settings(&self) -> options::AudioSettings {
+        options::AudioSettings {
+            channel: self.channel,
+            harmonics: self.harmonics,
+        }
+    }
+
     /// How the hum is traced: these lines, and the tracker's `--window` if one was given.
     pub fn hum(&self, tracker: &TrackerArgs) -> eenf::mains::HumOptions {
-        eenf::mains::HumOptions {
-            lines: self.harmonics,
-            window_s: tracker.window,
-        }
+        self.settings().hum(&tracker.settings())
     }
 
     /// The reading options (the rate follows from the harmonics tracked).
     pub fn options(&self) -> eenf::audio::AudioOptions {
-        eenf::audio::AudioOptions {
-            channel: self.channel,
-            top_hz: None,
-        }
+        self.settings().options()
     }
 }
 
@@ -443,13 +396,13 @@ pub struct VideoMethodArgs {
     #[arg(long, default_value = "auto")]
     pub nominal: Nominal,
     /// The sensor's readout time (first row to last row), ms: sets the idle rows.
-    #[arg(long, conflicts_with_all = ["idle", "virtual_rows"], value_parser = number_in(0.0, 1000.0))]
+    #[arg(long, conflicts_with_all = ["idle", "virtual_rows"], value_parser = number_in(limits::READOUT_MS))]
     pub readout_ms: Option<f64>,
     /// Idle rows: `auto` estimates them from the flicker's ripple within frames.
     #[arg(long, value_parser = ["auto"])]
     pub idle: Option<String>,
     /// Virtual rows per frame period (real plus idle), if known.
-    #[arg(long, conflicts_with = "idle", value_parser = number_in(0.0, 100_000.0))]
+    #[arg(long, conflicts_with = "idle", value_parser = number_in(limits::VIRTUAL_ROWS))]
     pub virtual_rows: Option<f64>,
     /// Row sampling: zero-pad (idle rows as zeros), naive (rows concatenated), global (one
     /// sample per frame, tracked at the alias of the flicker).
@@ -463,40 +416,28 @@ pub struct VideoMethodArgs {
     #[arg(long, default_value = "exact", value_parser = one_of::<PeakMethod>(&PeakMethod::NAMES))]
     pub peak: PeakMethod,
     /// STFT window, s.
-    #[arg(long, default_value_t = defaults::WINDOW_S, value_parser = number_in(0.01, 3600.0))]
+    #[arg(long, default_value_t = defaults::WINDOW_S, value_parser = number_in(limits::WINDOW_S))]
     pub window: f64,
 }
 
 impl VideoMethodArgs {
+    /// The library's option set.
+    pub fn settings(&self) -> options::VideoSettings {
+        options::VideoSettings {
+            nominal: self.nominal,
+            readout_ms: self.readout_ms,
+            idle: self.idle.clone(),
+            virtual_rows: self.virtual_rows,
+            sampling: self.sampling,
+            scene_removal: self.scene_removal,
+            peak: self.peak,
+            window: self.window,
+        }
+    }
+
     /// The V-ENF options these arguments ask for.
     pub fn options(&self) -> Result<VideoOptions> {
-        let nominal_hz = match self.nominal {
-            Nominal::Hz(f) => Some(f),
-            Nominal::Auto => None,
-        };
-        let idle = match (self.readout_ms, self.virtual_rows) {
-            (Some(ms), _) if ms > 0.0 => IdleRows::ReadoutS(ms / 1e3),
-            (Some(ms), _) => bail!("--readout-ms must be positive, not {ms}"),
-            (None, Some(l)) if l > 0.0 => IdleRows::VirtualRows(l),
-            (None, Some(l)) => bail!("--virtual-rows must be positive, not {l}"),
-            (None, None) => IdleRows::Auto,
-        };
-        let sampling = match self.sampling {
-            RowSampling::ZeroPad(_) => RowSampling::ZeroPad(idle),
-            other => other,
-        };
-        let params = EnfParams {
-            nominal_hz: nominal_hz.unwrap_or(50.0),
-            window_s: self.window,
-            peak: self.peak,
-            ..EnfParams::default()
-        };
-        Ok(VideoOptions {
-            nominal_hz,
-            sampling,
-            scene_removal: self.scene_removal,
-            params,
-        })
+        Ok(self.settings().options()?)
     }
 }
 
@@ -513,7 +454,7 @@ pub struct SimulateArgs {
     #[arg(long, default_value = "led")]
     pub lamp: String,
     /// Length of the recording, s.
-    #[arg(long, default_value_t = 60.0, value_parser = number_in(0.01, 86_400.0))]
+    #[arg(long, default_value_t = 60.0, value_parser = number_in(limits::DURATION_S))]
     pub duration: f64,
     /// Where the ENF comes from: `synthetic` (a grid-like random process), a mains WAV or a
     /// trace CSV (`time_s,enf_hz`, or `index,value` at --index-step), optionally with a start
@@ -521,10 +462,10 @@ pub struct SimulateArgs {
     #[arg(long, default_value = "synthetic")]
     pub enf: String,
     /// Seconds between the values of an `index,value` trace CSV.
-    #[arg(long, alias = "enf-step", default_value_t = 2.0, value_parser = number_in(0.001, 3600.0))]
+    #[arg(long, alias = "enf-step", default_value_t = 2.0, value_parser = number_in(limits::INDEX_STEP_S))]
     pub index_step: f64,
     /// Grid frequency of a synthetic ENF: 50 or 60 (a WAV's or trace's own is detected).
-    #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(50..=60))]
+    #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(limits::GRID_HZ.0 as i64..=limits::GRID_HZ.1 as i64))]
     pub grid: u32,
     /// Output recording; the format follows the extension (.aedat4, .raw = EVT 3.0, .dat,
     /// .txt) unless --format says. The truth goes beside it as NAME.truth.csv, every
@@ -542,18 +483,18 @@ pub struct SimulateArgs {
     #[arg(long, default_value = "dvxplorer")]
     pub readout: String,
     /// Overall light level (1 = indoor room); the scene classes set their own.
-    #[arg(long, value_parser = number_in(0.0, 1e6))]
+    #[arg(long, value_parser = number_in(limits::ILLUMINATION))]
     pub illumination: Option<f64>,
     /// Share of non-flickering light (daylight), 0..1.
-    #[arg(long, value_parser = number_in(0.0, 1.0))]
+    #[arg(long, value_parser = number_in(limits::AMBIENT))]
     pub ambient: Option<f64>,
     /// How much brighter the first lamp is inside its pool (`lamp-spot`) or bulb
     /// (`extreme-bright`) than elsewhere: sets how strongly those pixels flicker.
-    #[arg(long, value_parser = number_in(0.0, 1e6))]
+    #[arg(long, value_parser = number_in(limits::SPOT_GAIN))]
     pub spot_gain: Option<f64>,
     /// Background activity: each pixel's noise events per second under an indoor room's
     /// light (more in the dark), e.g. 0.5 for an old DVS128. Default: the simulator's 0.02.
-    #[arg(long, value_parser = number_in(0.0, 10_000.0))]
+    #[arg(long, value_parser = number_in(limits::NOISE_HZ))]
     pub noise_hz: Option<f64>,
     /// Local start time of the recording (names, timestamps; a WAV or CSV source named with
     /// its time sets it).
@@ -571,89 +512,34 @@ pub struct SimulateArgs {
     pub video: VideoArgs,
 }
 
-/// The simulation configuration from the arguments (its start is set from the timeline).
-fn config(a: &SimulateArgs) -> Result<SimConfig> {
-    if !(a.duration > 0.0 && a.duration <= 24.0 * 3600.0) {
-        bail!("--duration must be between 0 and 86400 s");
-    }
-    let (width, height) = parse_resolution(&a.resolution)?;
-    let readout = parse_readout(&a.readout)?;
-    let mut config = SimConfig {
-        width,
-        height,
-        duration_s: a.duration,
-        seed: a.seed,
-        lamps: parse_lamps(&a.lamp)?,
-        readout,
-        ..SimConfig::default()
-    }
-    .with_kinds(&parse_scene(&a.scene)?);
-    if let Some(i) = a.illumination {
-        config.illumination = i;
-    }
-    if let Some(x) = a.ambient {
-        config.ambient = x;
-    }
-    if let Some(g) = a.spot_gain {
-        match config.scene.bulb.as_mut() {
-            Some(b) if g > 0.0 => b.gain = g,
-            Some(_) => bail!("--spot-gain must be positive"),
-            None => {
-                bail!("--spot-gain needs a scene with a lamp in view (lamp-spot, extreme-bright)")
-            }
-        }
-    }
-    if let Some(n) = a.noise_hz {
-        if !(n >= 0.0 && n.is_finite()) {
-            bail!("--noise-hz must be zero or positive");
-        }
-        config.pixel.shot_noise_hz = n;
-        config.pixel.shot_noise_max_hz = config.pixel.shot_noise_max_hz.max(4.0 * n);
-    }
-    config.check().map_err(|e| anyhow::anyhow!("{e}"))?;
-    Ok(config)
-}
-
-/// The ENF source named by `--enf` (`synthetic`, or PATH[:START]: a colon followed by a
-/// number is the start second).
-fn enf_source(a: &SimulateArgs) -> Result<EnfSource> {
-    if a.enf == "synthetic" {
-        return Ok(EnfSource::Synthetic(a.grid as f64));
-    }
-    let (path, offset_s) = match a.enf.rsplit_once(':') {
-        Some((p, s)) if s.parse::<f64>().is_ok() => (PathBuf::from(p), s.parse::<f64>()?),
-        _ => (PathBuf::from(&a.enf), 0.0),
-    };
-    Ok(EnfSource::File {
-        path,
-        offset_s,
-        index_step_s: a.index_step,
-    })
-}
-
 impl SimulateArgs {
+    /// The library's option set.
+    pub fn settings(&self) -> options::SimulateSettings {
+        options::SimulateSettings {
+            scene: self.scene.clone(),
+            lamp: self.lamp.clone(),
+            duration: self.duration,
+            enf: self.enf.clone(),
+            index_step: self.index_step,
+            grid: self.grid,
+            output: self.output.clone(),
+            resolution: self.resolution.clone(),
+            seed: self.seed,
+            readout: self.readout.clone(),
+            illumination: self.illumination,
+            ambient: self.ambient,
+            spot_gain: self.spot_gain,
+            noise_hz: self.noise_hz,
+            start: self.start.clone(),
+            reference_dir: self.reference_dir.clone(),
+            events: self.events.settings(),
+            video: self.video.settings(),
+        }
+    }
+
     /// The recipe these flags ask for.
     pub fn recipe(&self) -> Result<Recipe> {
-        let a = self;
-        let format = a
-            .events
-            .format_for(&a.output, Some(OutputFormat::Aedat4(a.events.compression)))?;
-        let enf = enf_source(a)?;
-        if let EnfSource::Synthetic(grid) = enf {
-            if grid != 50.0 && grid != 60.0 {
-                bail!("--grid must be 50 or 60");
-            }
-        }
-        Ok(Recipe {
-            config: config(a)?,
-            enf,
-            start: a.start.clone(),
-            output: a.output.clone(),
-            format,
-            cameras: a.video.cameras()?,
-            mp4: a.video.mp4,
-            reference_dir: a.reference_dir.clone(),
-        })
+        Ok(self.settings().recipe()?)
     }
 }
 
@@ -661,7 +547,7 @@ impl SimulateArgs {
 #[derive(Debug, Clone, clap::Args)]
 pub struct MatchArgs {
     /// Candidates to list.
-    #[arg(long, default_value_t = 5, value_parser = count_in(1, 10_000))]
+    #[arg(long, default_value_t = 5, value_parser = count_in(limits::TOP))]
     pub top: usize,
     /// Check a claimed start time (e.g. 2022-08-17T16:10:00+08:00): its score, rank and
     /// significance.
@@ -671,7 +557,7 @@ pub struct MatchArgs {
     #[arg(long, default_value = "combined", value_parser = one_of::<eenf_dsp::matching::Score>(&eenf_dsp::matching::Score::NAMES))]
     pub score: eenf_dsp::matching::Score,
     /// A candidate is a match when its p-value is below this.
-    #[arg(long, default_value_t = eenf_dsp::matching::DEFAULT_ALPHA, value_parser = number_in(1e-300, 1.0))]
+    #[arg(long, default_value_t = eenf_dsp::matching::DEFAULT_ALPHA, value_parser = number_in(limits::ALPHA))]
     pub alpha: f64,
     /// Zone of the local times in hourly WAV names and grid archives: an IANA name
     /// (Europe/Berlin, Asia/Shanghai; summer time followed) or a UTC offset (+08:00, Z); also
@@ -681,14 +567,20 @@ pub struct MatchArgs {
 }
 
 impl MatchArgs {
-    /// What the search asks for.
-    pub fn query(&self) -> eenf::locate::MatchQuery {
-        eenf::locate::MatchQuery {
+    /// The library's option set.
+    pub fn settings(&self) -> options::MatchSettings {
+        options::MatchSettings {
             top: self.top,
-            score: self.score,
             verify: self.verify.clone(),
+            score: self.score,
             alpha: self.alpha,
+            tz: self.tz.clone(),
         }
+    }
+
+    /// What the search asks for.
+    pub fn query(&self) -> Result<eenf::locate::MatchQuery> {
+        Ok(self.settings().query()?)
     }
 }
 
@@ -701,32 +593,32 @@ pub struct EditArgs {
     /// The longest stretch whose phase is fitted on each side of a boundary, s: each recording
     /// is tested at the side up to this (2, 3, 5 or 10 s) whose smallest detectable jump is
     /// smallest, given its noise and the real grid's stray at that side.
-    #[arg(long, default_value_t = EditParams::default().side_s, value_parser = number_in(1.0, 600.0))]
+    #[arg(long, default_value_t = EditParams::default().side_s, value_parser = number_in(limits::SIDE_S))]
     pub side: f64,
     /// The shortest stretch between two edits told apart, s (also the shortest side fitted:
     /// the first and last this much of a recording are not tested).
-    #[arg(long, default_value_t = EditParams::default().min_gap_s, value_parser = number_in(0.3, 600.0))]
+    #[arg(long, default_value_t = EditParams::default().min_gap_s, value_parser = number_in(limits::MIN_GAP_S))]
     pub min_gap: f64,
     /// False alarms allowed per hour of unedited recording: sets the phase test's threshold
     /// from the noise measured in the recording and the real grid's own phase stray, measured
     /// on 24 continuous hours of real mains (0 findings there at the default 0.05, 95 % upper
     /// bound 0.12 per hour; in a phone's noise 3 in 130 hours of clips of them).
-    #[arg(long, default_value_t = EditParams::default().false_alarms_per_hour, value_parser = number_in(1e-9, 100.0))]
+    #[arg(long, default_value_t = EditParams::default().false_alarms_per_hour, value_parser = number_in(limits::FALSE_ALARMS))]
     pub false_alarms: f64,
     /// Report stretches where a phase jump this large (degrees of the lowest line) would go
     /// unseen as too weak to tell.
-    #[arg(long, default_value_t = EditParams::default().weak_jump_deg, value_parser = number_in(1.0, 180.0))]
+    #[arg(long, default_value_t = EditParams::default().weak_jump_deg, value_parser = number_in(limits::WEAK_JUMP_DEG))]
     pub weak_jump: f64,
     /// A frequency step is reported when it stands this many robust standard deviations of
     /// the recording's own steps.
-    #[arg(long, default_value_t = EditParams::default().frequency_step_z, value_parser = number_in(1.0, 1000.0))]
+    #[arg(long, default_value_t = EditParams::default().frequency_step_z, value_parser = number_in(limits::STEP_Z))]
     pub step_z: f64,
     /// The channel of a sound: `mix` (the mean of all) or a number from 0.
     #[arg(long, default_value = "mix")]
     pub channel: eenf::audio::Channel,
     /// Seconds between the values of an `index,value` trace CSV (a grid archive's day of
     /// values, for instance); a `time_s,enf_hz` CSV or eenf JSON carries its own times.
-    #[arg(long, value_parser = number_in(0.001, 3600.0))]
+    #[arg(long, value_parser = number_in(limits::INDEX_STEP_S))]
     pub index_step: Option<f64>,
     /// What the file is: auto (an event file when its content says so, a trace when its
     /// name ends in .csv or .json, else sound), audio, events, or trace.
@@ -738,33 +630,25 @@ pub struct EditArgs {
 }
 
 impl EditArgs {
-    /// The test's parameters.
-    pub fn params(&self) -> EditParams {
-        EditParams {
-            side_s: self.side,
-            min_gap_s: self.min_gap.min(self.side),
-            false_alarms_per_hour: self.false_alarms,
-            weak_jump_deg: self.weak_jump,
-            frequency_step_z: self.step_z,
+    /// The library's option set.
+    pub fn settings(&self) -> options::EditSettings {
+        options::EditSettings {
+            nominal: self.nominal,
+            side: self.side,
+            min_gap: self.min_gap,
+            false_alarms: self.false_alarms,
+            weak_jump: self.weak_jump,
+            step_z: self.step_z,
+            channel: self.channel,
+            index_step: self.index_step,
+            kind: self.kind,
+            input: self.input.settings(),
         }
     }
 
     /// Everything `edits` needs: the test, the grid, how sound and events are read.
-    pub fn options(&self) -> EditOptions {
-        EditOptions {
-            params: self.params(),
-            input: self.kind,
-            index_step_s: self.index_step,
-            audio: eenf::audio::AudioOptions {
-                channel: self.channel,
-                top_hz: None,
-            },
-            extract: ExtractOptions {
-                nominal: self.nominal,
-                open: self.input.options(),
-                ..ExtractOptions::default()
-            },
-        }
+    pub fn options(&self) -> Result<EditOptions> {
+        Ok(self.settings().options()?)
     }
 }
 
@@ -803,34 +687,83 @@ pub struct StoreInputArgs {
     #[arg(long)]
     pub no_wait: bool,
     /// Seconds between values of `index,value` CSVs.
-    #[arg(long, alias = "step", value_parser = number_in(0.001, 3600.0))]
+    #[arg(long, alias = "step", value_parser = number_in(limits::INDEX_STEP_S))]
     pub index_step: Option<f64>,
 }
 
 impl StoreInputArgs {
+    /// The library's option set.
+    pub fn settings(&self) -> options::StoreInputSettings {
+        options::StoreInputSettings {
+            grid: self.grid.clone(),
+            tz: self.tz.clone(),
+            format: self.format,
+            value_unit: self.value_unit,
+            date_order: self.date_order,
+            nominal: self.nominal,
+            start: self.start.clone(),
+            no_wait: self.no_wait,
+            index_step: self.index_step,
+        }
+    }
+
     /// The build of `inputs`, as the library takes it.
     pub fn build(&self, inputs: Vec<String>) -> Result<eenf::reference::StoreBuild> {
-        Ok(eenf::reference::StoreBuild {
-            inputs,
-            grid: self.grid.clone(),
-            zone: self.tz.clone(),
-            archive: ArchiveOptions {
-                format: self.format,
-                zone: None,
-                unit: self.value_unit,
-                date_order: self.date_order,
-                nominal_hz: match self.nominal {
-                    Nominal::Hz(f) => Some(f),
-                    Nominal::Auto => None,
-                },
-            },
-            start: self
-                .start
-                .as_deref()
-                .map(eenf::time::parse_time)
-                .transpose()?,
-            index_step_s: self.index_step,
-            wait: !self.no_wait,
-        })
+        Ok(self.settings().build(inputs)?)
     }
+}
+
+/// The option sets the Python package and the page take, by name: each with the flags' library
+/// names, defaults, help and choices, as `eenf::options::DOCS_JSON` holds them (a test keeps
+/// that file equal to this, so that the help is written once, here).
+pub fn option_docs() -> serde_json::Value {
+    use clap::Args as _;
+    /// Adds an option set's flags to a command.
+    type Augment = fn(clap::Command) -> clap::Command;
+    let sets: [(&str, Augment); 9] = [
+        ("input", InputArgs::augment_args),
+        ("extract", MethodArgs::augment_args),
+        ("reference", |c| {
+            TrackerArgs::augment_args(AudioArgs::augment_args(c))
+        }),
+        ("video", VideoMethodArgs::augment_args),
+        ("simulate", SimulateArgs::augment_args),
+        ("match", MatchArgs::augment_args),
+        ("write", EventOutputArgs::augment_args),
+        ("edits", EditArgs::augment_args),
+        ("refdb_build", StoreInputArgs::augment_args),
+    ];
+    let mut out = serde_json::Map::new();
+    for (name, augment) in sets {
+        let cmd = augment(clap::Command::new("eenf"));
+        let options: Vec<serde_json::Value> = cmd
+            .get_arguments()
+            .filter_map(|a| {
+                let long = a.get_long().filter(|l| *l != "help")?;
+                let default = a
+                    .get_default_values()
+                    .first()
+                    .map(|v| v.to_string_lossy().into_owned());
+                let help = a
+                    .get_long_help()
+                    .or(a.get_help())
+                    .map(|h| h.to_string())
+                    .unwrap_or_default();
+                let choices: Vec<String> = a
+                    .get_possible_values()
+                    .iter()
+                    .map(|v| v.get_name().to_string())
+                    .collect();
+                Some(serde_json::json!({
+                    "name": long.replace('-', "_"),
+                    "switch": !a.get_action().takes_values(),
+                    "default": default,
+                    "help": help,
+                    "choices": choices,
+                }))
+            })
+            .collect();
+        out.insert(name.to_string(), options.into());
+    }
+    out.into()
 }

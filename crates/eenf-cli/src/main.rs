@@ -68,6 +68,8 @@ const ALLOCATOR_WARM_UP: usize = 16 << 20;
 
 fn main() -> ExitCode {
     drop(std::hint::black_box(vec![0u8; ALLOCATOR_WARM_UP]));
+    // messages name options as this front end's users write them: `--max-gap`
+    eenf_core::spelling::set_spelling(eenf_core::spelling::Spelling::Flags);
     // `--window -3` reaches the flag's own range check, not clap's guess that `-3` is a flag
     let matches = negative_numbers(Cli::command()).try_get_matches();
     let cli = match matches.and_then(|m| Cli::from_arg_matches(&m)) {

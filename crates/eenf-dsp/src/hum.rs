@@ -11,6 +11,7 @@
 //! and Hilferty 1931). Spectrum combining over harmonics follows Hajj-Ahmad, Garg and Wu
 //! (2013): every harmonic that stands may carry the ENF.
 
+use eenf_core::spelling::option;
 use rayon::prelude::*;
 use realfft::RealFftPlanner;
 
@@ -273,13 +274,14 @@ impl HumSearch {
         if !standing.is_empty() && standing.iter().all(|l| l.shared) {
             let l = standing[0];
             return format!(
-                "the only mains line, at {:.3} Hz, is a harmonic of both grids ({}): name the grid with --nominal",
+                "the only mains line, at {:.3} Hz, is a harmonic of both grids ({}): name the grid with {}",
                 l.f0_hz * l.harmonic as f64 * self.multiple,
                 standing
                     .iter()
                     .map(|l| format!("{} x {} Hz", l.harmonic as f64 * self.multiple, l.grid_hz))
                     .collect::<Vec<_>>()
-                    .join(" = ")
+                    .join(" = "),
+                option("nominal")
             );
         }
         match self.strongest() {

@@ -6,6 +6,7 @@
 //! it too: one flipped bit must not stretch a one-second recording into two days. With
 //! [`OpenOptions::strict`](crate::OpenOptions) both are errors instead.
 
+use eenf_core::spelling::{option, switch};
 use std::fmt;
 use std::path::PathBuf;
 
@@ -54,8 +55,10 @@ impl fmt::Display for Damage {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{}; the {} events before it are read (--strict refuses the file)",
-            self.message, self.events_before
+            "{}; the {} events before it are read ({} refuses the file)",
+            self.message,
+            self.events_before,
+            switch("strict")
         )
     }
 }
@@ -163,10 +166,11 @@ impl EventReader for Guarded {
             };
             let offset = self.inner.batch_offset().unwrap_or(0);
             let reason = format!(
-                "timestamp jumps from {:.6} s to {:.6} s, more than the {} s allowed (--max-gap)",
+                "timestamp jumps from {:.6} s to {:.6} s, more than the {} s allowed ({})",
                 before as f64 * 1e-6,
                 batch.t[i] as f64 * 1e-6,
-                self.max_gap as f64 * 1e-6
+                self.max_gap as f64 * 1e-6,
+                option("max_gap")
             );
             let e = EventError::Corrupt {
                 path: self.path.clone(),

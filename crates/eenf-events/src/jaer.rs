@@ -1,5 +1,6 @@
 //! jAER AEDAT 2.0 and AEDAT 3.1 readers. See `docs/formats.md`.
 
+use eenf_core::spelling::option;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
@@ -194,8 +195,9 @@ pub fn aedat2_with(
         None => chip(&header.lines).or_else(|| {
             let inferred = infer_chip(&addresses)?;
             notes.push(format!(
-                "{named}: chip inferred from the addresses as {} (--chip overrides)",
-                inferred.3
+                "{named}: chip inferred from the addresses as {} ({} overrides)",
+                inferred.3,
+                option("chip")
             ));
             Some(inferred)
         }),
@@ -206,7 +208,8 @@ pub fn aedat2_with(
             format: "AEDAT 2.0",
             offset: 0,
             reason: format!(
-                "unknown chip ({named}); known: DAVIS240, DAVIS346, DAVIS640, DVS128 (name it with --chip)"
+                "unknown chip ({named}); known: DAVIS240, DAVIS346, DAVIS640, DVS128 (name it with {})",
+                option("chip")
             ),
         });
     };

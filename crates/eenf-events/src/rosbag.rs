@@ -10,6 +10,7 @@
 //! Sizes read from the file bound reads (never allocations): a chunk can hold no more than
 //! the file has left, and expands to at most [`MAX_CHUNK`].
 
+use eenf_core::spelling::option;
 use std::collections::HashMap;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
@@ -279,7 +280,7 @@ pub fn reader(
             path: path.to_path_buf(),
             reason: match topic {
                 Some(name) => format!("no topic {name:?} in the bag; it has: {}", listing()),
-                None if topics.is_empty() => "a bag without an index (not closed properly): give --topic, or reindex it with `rosbag reindex`".into(),
+                None if topics.is_empty() => format!("a bag without an index (not closed properly): give {}, or reindex it with `rosbag reindex`", option("topic")),
                 None => format!("no topic of event messages ({}) in the bag; it has: {}", crate::rosmsg::TYPES, listing()),
             },
         });

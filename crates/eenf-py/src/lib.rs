@@ -2,10 +2,9 @@
 //!
 //! A thin layer: each function turns Python values into the library's types, calls the
 //! library with the GIL released, and turns the result into numpy arrays, a `Trace` or a dict
-//! (as JSON text, which `eenf/__init__.py` loads). Keyword arguments reach here as the
-//! command line's flags (`window=8` → `--window 8`) and are parsed by the same option sets
-//! (`eenf_cli::args`) as the `eenf` command, so names, defaults and checks are the CLI's;
-//! errors name keyword arguments, not flags.
+//! (as JSON text, which `eenf/__init__.py` loads). Keyword arguments reach here as a JSON
+//! object and fill the library's option sets (`eenf::options`), which check them: the names,
+//! defaults and ranges are the command line's, and messages name keyword arguments.
 //! The friendly signatures, structured arrays and plots live in `python/eenf/__init__.py`.
 
 #![forbid(unsafe_code)]
@@ -13,15 +12,11 @@
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
-use clap::{Args as ClapArgs, FromArgMatches};
 use eenf::audio::Sound;
+use eenf::options::{self as opts, OptionSet};
 use eenf::progress::Progress;
 use eenf::recording::Recording;
 use eenf::trace::Trace;
-use eenf_cli::args::{
-    AudioArgs, EditArgs, EventOutputArgs, InputArgs, MatchArgs, MethodArgs, SimulateArgs,
-    StoreInputArgs, TrackerArgs, VideoMethodArgs,
-};
 use eenf_core::Nominal;
 use eenf_events::{EventBatch, EventReader};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
@@ -32,49 +27,12 @@ use pyo3::prelude::*;
 /// `eenf.EVENT_DTYPE` views them as).
 const RECORD: usize = 13;
 
-/// A message in Python's words: a flag (`--window <WINDOW>`, `--no-wait`) becomes the keyword
-/// argument that sets it (`window`, `no_wait`), and clap's "unexpected argument" an
-/// "unexpected keyword argument".
-fn python_names(msg: &str) -> String {
-    let msg = msg.replace("unexpected argument", "unexpected keyword argument");
-    let mut out = String::with_capacity(msg.len());
-    let mut rest = msg.as_str();
-    while let Some(i) = rest.find("--") {
-        let (before, after) = rest.split_at(i);
-        let name_len = after[2..]
-            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
-            .unwrap_or(after.len() - 2);
-        let name = &after[2..2 + name_len];
-        out.push_str(before);
-        if name.starts_with(|c: char| c.is_ascii_lowercase()) {
-            out.push_str(&name.replace('-', "_"));
-            rest = &after[2 + name_len..];
-            // clap's value placeholder (` <WINDOW>`) goes with the flag
-            if let Some(tail) = rest.strip_prefix(" <") {
-                if let Some(end) = tail.find('>') {
-                    if tail[..end]
-                        .chars()
-                        .all(|c| c.is_ascii_uppercase() || c == '_')
-                    {
-                        rest = &tail[end + 1..];
-                    }
-                }
-            }
-        } else {
-            out.push_str("--");
-            rest = &after[2..];
-        }
-    }
-    out.push_str(rest);
-    out
-}
-
 /// An error of the library as a Python exception: `OSError` (the subclass Python picks for
 /// the OS error's kind, e.g. `FileNotFoundError`) when a file could not be read or written,
-/// `ValueError` for bad data or parameters. Flags in the message are named as keyword
-/// arguments.
+/// `ValueError` for bad data or parameters. Messages name options as keyword arguments (the
+/// module sets that spelling when it loads).
 fn py_err(e: anyhow::Error) -> PyErr {
-    let msg = python_names(&format!("{e:#}"));
+    let msg = format!("{e:#}");
     for cause in e.chain() {
         let kind = match cause.downcast_ref::<eenf_events::EventError>() {
             Some(eenf_events::EventError::Io { error, .. }) => Some(error.kind()),
@@ -91,70 +49,27 @@ fn events_err(e: eenf_events::EventError) -> PyErr {
     py_err(e.into())
 }
 
-/// Parses keyword arguments (already turned into flags) with one of the CLI's option sets.
-fn parse<T: ClapArgs + FromArgMatches>(what: &'static str, argv: Vec<String>) -> PyResult<T> {
-    let cmd = T::augment_args(clap::Command::new(what).no_binary_name(true));
-    let bad = |e: clap::Error| {
-        let text = e.render().to_string();
-        let line = text.lines().next().unwrap_or("bad arguments").trim();
-        PyValueError::new_err(python_names(&format!(
-            "{what}: {}",
-            line.strip_prefix("error: ").unwrap_or(line)
-        )))
-    };
-    let m = cmd.try_get_matches_from(argv).map_err(bad)?;
-    T::from_arg_matches(&m).map_err(bad)
+/// A refused option set as a Python exception: `ValueError`, naming the keyword argument.
+fn option_err(e: opts::OptionError) -> PyErr {
+    PyValueError::new_err(e.to_string())
 }
 
-/// The option set behind `what`.
-fn option_set(what: &str) -> PyResult<clap::Command> {
-    let c = clap::Command::new("eenf");
-    Ok(match what {
-        "input" => InputArgs::augment_args(c),
-        "extract" => MethodArgs::augment_args(c),
-        "reference" => TrackerArgs::augment_args(AudioArgs::augment_args(c)),
-        "video" => VideoMethodArgs::augment_args(c),
-        "simulate" => SimulateArgs::augment_args(c),
-        "match" => MatchArgs::augment_args(c),
-        "write" => EventOutputArgs::augment_args(c),
-        "edits" => EditArgs::augment_args(c),
-        "refdb_build" => StoreInputArgs::augment_args(c),
-        _ => return Err(PyValueError::new_err(format!("no option set {what:?}"))),
-    })
+/// An option set of type `T` filled from keyword arguments (`options`: a JSON object), checked.
+fn settings<T: OptionSet + Default>(options: &str) -> PyResult<T> {
+    let mut set = T::default();
+    opts::apply_json(&mut [&mut set], options).map_err(option_err)?;
+    Ok(set)
 }
 
-/// One keyword argument: name, default, help, choices.
-type OptionDoc = (String, Option<String>, String, Vec<String>);
-
-/// The keyword arguments of an option set: (name, default, help, choices) each, for the
-/// docstrings and `help()`.
+/// The keyword arguments of an option set (`extract`, `match`, ...), as JSON text: a list of
+/// `{"name", "default", "help", "choices", "switch"}`, for the docstrings and `help()`.
 #[pyfunction]
-fn options(what: &str) -> PyResult<Vec<OptionDoc>> {
-    let cmd = option_set(what)?;
-    Ok(cmd
-        .get_arguments()
-        .filter_map(|a| {
-            let long = a.get_long()?;
-            if long == "help" {
-                return None;
-            }
-            let default = a
-                .get_default_values()
-                .first()
-                .map(|v| v.to_string_lossy().into_owned());
-            let help = a
-                .get_long_help()
-                .or(a.get_help())
-                .map(|h| h.to_string())
-                .unwrap_or_default();
-            let choices = a
-                .get_possible_values()
-                .iter()
-                .map(|v| v.get_name().to_string())
-                .collect();
-            Some((long.replace('-', "_"), default, help, choices))
-        })
-        .collect())
+fn options(what: &str) -> PyResult<String> {
+    let docs: serde_json::Value =
+        serde_json::from_str(opts::DOCS_JSON).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    docs.get(what)
+        .map(|v| v.to_string())
+        .ok_or_else(|| PyValueError::new_err(format!("no option set {what:?}")))
 }
 
 /// Packs events `range` of a batch into 13-byte records (see [`RECORD`]).
@@ -185,17 +100,17 @@ fn damage_warning(r: &dyn EventReader) -> Option<String> {
 /// Reads the events of `path` with `start_s <= t - t0 < end_s` (seconds from the first
 /// event) into packed records, with the warnings met (damage). The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (path, start_s=None, end_s=None, argv=Vec::new()))]
+#[pyo3(signature = (path, start_s=None, end_s=None, options="{}"))]
 fn read_events<'py>(
     py: Python<'py>,
     path: PathBuf,
     start_s: Option<f64>,
     end_s: Option<f64>,
-    argv: Vec<String>,
+    options: &str,
 ) -> PyResult<(Bound<'py, PyArray1<u8>>, Option<String>)> {
-    let input: InputArgs = parse("read_events", argv)?;
+    let input: opts::InputSettings = settings(options)?;
     let (bytes, warning) = py.detach(|| -> PyResult<(Vec<u8>, Option<String>)> {
-        let mut r = eenf_events::open_with(&path, &input.options()).map_err(events_err)?;
+        let mut r = eenf_events::open_with(&path, &input.open_options()).map_err(events_err)?;
         let mut out = Vec::new();
         if let Some(n) = r.info().event_count {
             // a hint only: bounded, never trusted for the whole file
@@ -237,14 +152,14 @@ struct IterState {
 #[pymethods]
 impl EventIterator {
     #[new]
-    #[pyo3(signature = (path, batch=1_000_000, argv=Vec::new()))]
-    fn new(py: Python<'_>, path: PathBuf, batch: usize, argv: Vec<String>) -> PyResult<Self> {
+    #[pyo3(signature = (path, batch=1_000_000, options="{}"))]
+    fn new(py: Python<'_>, path: PathBuf, batch: usize, options: &str) -> PyResult<Self> {
         if batch == 0 {
             return Err(PyValueError::new_err("batch must be at least 1"));
         }
-        let input: InputArgs = parse("iter_events", argv)?;
+        let input: opts::InputSettings = settings(options)?;
         let reader = py
-            .detach(|| eenf_events::open_with(&path, &input.options()))
+            .detach(|| eenf_events::open_with(&path, &input.open_options()))
             .map_err(events_err)?;
         Ok(EventIterator {
             state: Mutex::new(IterState {
@@ -302,11 +217,11 @@ impl EventIterator {
 
 /// `eenf info --json` of a file, as JSON text. The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (path, argv=Vec::new()))]
-fn info(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<String> {
-    let input: InputArgs = parse("info", argv)?;
+#[pyo3(signature = (path, options="{}"))]
+fn info(py: Python<'_>, path: PathBuf, options: &str) -> PyResult<String> {
+    let input: opts::InputSettings = settings(options)?;
     py.detach(|| {
-        let found = eenf::inspect::inspect(&path, &input.options())?;
+        let found = eenf::inspect::inspect(&path, &input.open_options())?;
         Ok(found.to_json(&path).to_string())
     })
     .map_err(py_err)
@@ -430,17 +345,17 @@ fn traced(r: anyhow::Result<Trace>) -> PyResult<PyTrace> {
 
 /// E-ENF from an event file (`eenf extract`). The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (path, argv=Vec::new()))]
-fn extract(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<PyTrace> {
-    let m: MethodArgs = parse("extract", argv)?;
-    let opts = m.options().map_err(py_err)?;
-    traced(py.detach(|| eenf::extract::extract(&Recording::File(path), &opts, &Progress::hidden())))
+#[pyo3(signature = (path, options="{}"))]
+fn extract(py: Python<'_>, path: PathBuf, options: &str) -> PyResult<PyTrace> {
+    let set: opts::ExtractSettings = settings(options)?;
+    let o = set.options().map_err(option_err)?;
+    traced(py.detach(|| eenf::extract::extract(&Recording::File(path), &o, &Progress::hidden())))
 }
 
 /// E-ENF from events in memory (columns; `name` names them in messages and in the trace).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (t, x, y, p, width, height, name, argv=Vec::new()))]
+#[pyo3(signature = (t, x, y, p, width, height, name, options="{}"))]
 fn extract_events(
     py: Python<'_>,
     t: PyReadonlyArray1<'_, i64>,
@@ -450,10 +365,10 @@ fn extract_events(
     width: u16,
     height: u16,
     name: PathBuf,
-    argv: Vec<String>,
+    options: &str,
 ) -> PyResult<PyTrace> {
-    let m: MethodArgs = parse("extract", argv)?;
-    let opts = m.options().map_err(py_err)?;
+    let set: opts::ExtractSettings = settings(options)?;
+    let o = set.options().map_err(option_err)?;
     let events = Arc::new(batch_of(t, x, y, p)?);
     let rec = Recording::Memory {
         name,
@@ -461,15 +376,15 @@ fn extract_events(
         width,
         height,
     };
-    traced(py.detach(|| eenf::extract::extract(&rec, &opts, &Progress::hidden())))
+    traced(py.detach(|| eenf::extract::extract(&rec, &o, &Progress::hidden())))
 }
 
 /// The ENF of a sound file (`eenf reference`). The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (path, argv=Vec::new()))]
-fn reference(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<PyTrace> {
-    let (audio, tracker) = parse::<ReferenceArgs>("reference", argv)?.split();
-    let params = tracker.params().map_err(py_err)?;
+#[pyo3(signature = (path, options="{}"))]
+fn reference(py: Python<'_>, path: PathBuf, options: &str) -> PyResult<PyTrace> {
+    let (audio, tracker) = sound_settings(options)?;
+    let params = tracker.params().map_err(option_err)?;
     traced(py.detach(|| {
         eenf::mains::sound_trace(
             &Sound::File(&path),
@@ -483,17 +398,17 @@ fn reference(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<PyTra
 
 /// The ENF of samples in memory: `interleaved` frames of `channels` channels at `fs` Hz.
 #[pyfunction]
-#[pyo3(signature = (interleaved, channels, fs, name, argv=Vec::new()))]
+#[pyo3(signature = (interleaved, channels, fs, name, options="{}"))]
 fn reference_samples(
     py: Python<'_>,
     interleaved: PyReadonlyArray1<'_, f32>,
     channels: usize,
     fs: f64,
     name: PathBuf,
-    argv: Vec<String>,
+    options: &str,
 ) -> PyResult<PyTrace> {
-    let (audio, tracker) = parse::<ReferenceArgs>("reference", argv)?.split();
-    let params = tracker.params().map_err(py_err)?;
+    let (audio, tracker) = sound_settings(options)?;
+    let params = tracker.params().map_err(option_err)?;
     let samples = interleaved
         .as_slice()
         .map_err(|e| PyValueError::new_err(e.to_string()))?
@@ -515,28 +430,20 @@ fn reference_samples(
     }))
 }
 
-/// `reference`'s two option sets together.
-#[derive(clap::Args)]
-struct ReferenceArgs {
-    #[command(flatten)]
-    audio: AudioArgs,
-    #[command(flatten)]
-    tracker: TrackerArgs,
-}
-
-impl ReferenceArgs {
-    fn split(self) -> (AudioArgs, TrackerArgs) {
-        (self.audio, self.tracker)
-    }
+/// `reference`'s two option sets, filled from keyword arguments and checked.
+fn sound_settings(options: &str) -> PyResult<(opts::AudioSettings, opts::TrackerSettings)> {
+    let (mut audio, mut tracker) = Default::default();
+    opts::apply_json(&mut [&mut audio, &mut tracker], options).map_err(option_err)?;
+    Ok((audio, tracker))
 }
 
 /// V-ENF from a video (`eenf video`). The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (path, argv=Vec::new()))]
-fn video(py: Python<'_>, path: PathBuf, argv: Vec<String>) -> PyResult<PyTrace> {
-    let m: VideoMethodArgs = parse("video", argv)?;
-    let opts = m.options().map_err(py_err)?;
-    traced(py.detach(|| eenf::video::trace_video(&path, &opts, &Progress::hidden())))
+#[pyo3(signature = (path, options="{}"))]
+fn video(py: Python<'_>, path: PathBuf, options: &str) -> PyResult<PyTrace> {
+    let set: opts::VideoSettings = settings(options)?;
+    let o = set.options().map_err(option_err)?;
+    traced(py.detach(|| eenf::video::trace_video(&path, &o, &Progress::hidden())))
 }
 
 /// Draws `trace` into `path` (`.png` or `.svg`) as `eenf extract --plot` does: its ENF, each
@@ -612,18 +519,18 @@ fn compare(
 /// `eenf match`: where a trace fits in long references, as `eenf match --json` prints it.
 /// The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (trace, name, reference, argv=Vec::new()))]
+#[pyo3(signature = (trace, name, reference, options="{}"))]
 fn match_trace(
     py: Python<'_>,
     trace: PyRef<'_, PyTrace>,
     name: PathBuf,
     reference: PathBuf,
-    argv: Vec<String>,
+    options: &str,
 ) -> PyResult<String> {
-    let m: MatchArgs = parse("match", argv)?;
+    let m: opts::MatchSettings = settings(options)?;
+    let query = m.query().map_err(option_err)?;
     let t = trace.0.clone();
     py.detach(|| {
-        let query = m.query();
         let located = eenf::locate::locate(
             &t,
             &name,
@@ -641,15 +548,15 @@ fn match_trace(
 /// `store` (created when missing); returns the grids changed and what each archive gave, as
 /// JSON text. The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (store, inputs, argv=Vec::new()))]
+#[pyo3(signature = (store, inputs, options="{}"))]
 fn refdb_build(
     py: Python<'_>,
     store: PathBuf,
     inputs: Vec<String>,
-    argv: Vec<String>,
+    options: &str,
 ) -> PyResult<String> {
-    let a: StoreInputArgs = parse("refdb_build", argv)?;
-    let build = a.build(inputs).map_err(py_err)?;
+    let a: opts::StoreInputSettings = settings(options)?;
+    let build = a.build(inputs).map_err(option_err)?;
     py.detach(|| {
         let built = eenf::reference::build_store(&store, &build, &Progress::hidden(), || {})?;
         let grids: Vec<_> = built
@@ -670,10 +577,10 @@ fn refdb_build(
 /// `eenf simulate`: writes a recording and its truth; returns what was written, as JSON text.
 /// The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (argv=Vec::new()))]
-fn simulate(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
-    let a: SimulateArgs = parse("simulate", argv)?;
-    let recipe = a.recipe().map_err(py_err)?;
+#[pyo3(signature = (options="{}"))]
+fn simulate(py: Python<'_>, options: &str) -> PyResult<String> {
+    let a: opts::SimulateSettings = settings(options)?;
+    let recipe = a.recipe().map_err(option_err)?;
     py.detach(|| {
         let r = eenf::simulation::simulate_recording(&recipe, &Progress::hidden())?;
         Ok(serde_json::json!({
@@ -690,7 +597,7 @@ fn simulate(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
 /// returns the number written. The GIL is released.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (path, t, x, y, p, width, height, argv=Vec::new()))]
+#[pyo3(signature = (path, t, x, y, p, width, height, options="{}"))]
 fn write_events(
     py: Python<'_>,
     path: PathBuf,
@@ -700,10 +607,10 @@ fn write_events(
     p: PyReadonlyArray1<'_, bool>,
     width: u16,
     height: u16,
-    argv: Vec<String>,
+    options: &str,
 ) -> PyResult<u64> {
-    let out: EventOutputArgs = parse("write_events", argv)?;
-    let format = out.format_for(&path, None).map_err(py_err)?;
+    let out: opts::EventOutputSettings = settings(options)?;
+    let format = out.format_for(&path, None).map_err(option_err)?;
     let events = batch_of(t, x, y, p)?;
     py.detach(|| {
         eenf_events::memory::check_events(&events, width, height, &path)?;
@@ -748,27 +655,27 @@ fn edits_out(py: Python<'_>, r: anyhow::Result<eenf::edits::EditReport>) -> PyRe
 
 /// Edits of a file (`eenf edits`). The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (path, argv=Vec::new()))]
-fn edits<'py>(py: Python<'py>, path: PathBuf, argv: Vec<String>) -> PyResult<EditsOut<'py>> {
-    let a = parse::<EditArgs>("edits", argv)?;
-    let opts = a.options();
-    let r = py.detach(|| eenf::edits::file_edits(&path, &opts, &Progress::hidden()));
+#[pyo3(signature = (path, options="{}"))]
+fn edits<'py>(py: Python<'py>, path: PathBuf, options: &str) -> PyResult<EditsOut<'py>> {
+    let a: opts::EditSettings = settings(options)?;
+    let o = a.options().map_err(option_err)?;
+    let r = py.detach(|| eenf::edits::file_edits(&path, &o, &Progress::hidden()));
     edits_out(py, r)
 }
 
 /// Edits of samples in memory: `interleaved` frames of `channels` channels at `fs` Hz.
 #[pyfunction]
-#[pyo3(signature = (interleaved, channels, fs, name, argv=Vec::new()))]
+#[pyo3(signature = (interleaved, channels, fs, name, options="{}"))]
 fn edits_samples<'py>(
     py: Python<'py>,
     interleaved: PyReadonlyArray1<'_, f32>,
     channels: usize,
     fs: f64,
     name: PathBuf,
-    argv: Vec<String>,
+    options: &str,
 ) -> PyResult<EditsOut<'py>> {
-    let a = parse::<EditArgs>("edits", argv)?;
-    let opts = a.options();
+    let a: opts::EditSettings = settings(options)?;
+    let o = a.options().map_err(option_err)?;
     let samples = interleaved
         .as_slice()
         .map_err(|e| PyValueError::new_err(e.to_string()))?
@@ -780,7 +687,7 @@ fn edits_samples<'py>(
             channels,
             fs,
         };
-        eenf::edits::sound_edits(&sound, &opts.audio, opts.extract.nominal, &opts.params)
+        eenf::edits::sound_edits(&sound, &o.audio, o.extract.nominal, &o.params)
     });
     edits_out(py, r)
 }
@@ -788,6 +695,8 @@ fn edits_samples<'py>(
 /// The native module.
 #[pymodule]
 fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // messages name options as Python's users write them: `max_gap=`
+    eenf_core::spelling::set_spelling(eenf_core::spelling::Spelling::Keywords);
     m.add("RECORD_BYTES", RECORD)?;
     m.add("VERSION", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<PyTrace>()?;

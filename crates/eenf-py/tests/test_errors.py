@@ -112,3 +112,50 @@ def test_absurd_numbers_raise_value_errors(sim, tmp_path):
     bad.write_text("time_s,enf_hz\n" + "".join(f"{i}e-9,50.0\n" for i in range(60)))
     with pytest.raises(ValueError, match="s apart"):
         eenf.Trace.read(bad)
+
+
+def test_options_are_checked_by_the_library_and_named_as_keywords(sim, tmp_path):
+    """Keyword arguments fill the library's option sets (no command-line parser in the
+    wheel): each kind of refusal is a ValueError naming the keyword, never a flag."""
+    cases = [
+        (lambda: eenf.extract(sim.recording, harmonics="many"), r"'harmonics': not a whole number"),
+        (lambda: eenf.extract(sim.recording, window="wide"), r"'window': not a number"),
+        (lambda: eenf.extract(sim.recording, window=float("nan")), r"'window': NaN is outside"),
+        (lambda: eenf.extract(sim.recording, strict="yes"), r"'strict': expected true or false"),
+        (lambda: eenf.video(sim.recording, readout_ms=10.0, idle="auto"), r"readout_ms cannot be used with idle"),
+        (lambda: eenf.video(sim.recording, idle="some"), r"'idle': expected auto"),
+        (lambda: eenf.simulate(output=tmp_path / "s.aedat4", resolution="big"), r"resolution \"big\": expected WxH"),
+        (lambda: eenf.simulate(output=tmp_path / "s.aedat4", scene="static", spot_gain=2.0), r"spot_gain needs a scene"),
+        (lambda: eenf.edits(sim.recording, side=0.5), r"'side': 0.5 is outside 1..=600"),
+        (lambda: eenf.write_events(tmp_path / "x.unknown", events()), r"pass format aedat4"),
+    ]
+    for call, message in cases:
+        with pytest.raises(ValueError, match=message) as e:
+            call()
+        assert "--" not in str(e.value), str(e.value)
+    assert not list(tmp_path.iterdir())
+
+
+def test_library_messages_name_keywords(sim, tmp_path):
+    """Advice in the library's messages names the keyword argument, as the command line's
+    names its flag: `strict=True`, `tz=...`."""
+    data = open(sim.recording, "rb").read()
+    cut = tmp_path / "cut.aedat4"
+    cut.write_bytes(data[: len(data) * 6 // 10])
+    with pytest.warns(eenf.EenfWarning, match=r"strict=True refuses the file"):
+        eenf.read_events(cut)
+    local = tmp_path / "local.csv"
+    local.write_text("time,frequency\n" + "".join(f"2022-08-17 16:00:{s:02d},50.01\n" for s in range(60)))
+    with pytest.raises(ValueError, match=r"give it with tz \(") as e:
+        eenf.refdb_build(tmp_path / "store", local)
+    assert "--" not in str(e.value)
+
+
+def test_os_errors_keep_their_kind(sim, tmp_path):
+    """A file that cannot be written is the OSError subclass of its cause."""
+    t = eenf.Trace.from_values(np.full(60, 50.0))
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(NotADirectoryError):
+        t.to_csv(tmp_path / "file" / "t.csv")
+    with pytest.raises(IsADirectoryError):
+        t.to_csv(tmp_path)

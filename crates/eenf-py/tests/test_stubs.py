@@ -1,7 +1,8 @@
 """The type stubs name every keyword parameter the library takes, with its default: they are
-checked against the option sets the native module parses (the command line's)."""
+checked against the option sets the native module fills (the command line's)."""
 
 import ast
+import json
 from pathlib import Path
 
 import eenf
@@ -32,10 +33,11 @@ def test_stubs_match_the_option_sets():
     for fn, sets in SETS.items():
         names, defaults = stubs[fn]
         for s in sets:
-            for name, default, _, choices in _eenf.options(s):
+            for o in json.loads(_eenf.options(s)):
+                name, default = o["name"], o["default"]
                 assert name in names, f"{fn}: {name} missing from the stub"
                 # output: None stands for the command line's default name
-                if default is None or choices == ["true", "false"] or name == "output":
+                if default is None or o["switch"] or name == "output":
                     continue
                 d = defaults[name]
                 assert str(d) == default or (isinstance(d, float) and d == float(default)), (fn, name, d, default)

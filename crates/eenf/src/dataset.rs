@@ -2,6 +2,7 @@
 //! references `YYYY_MM_DD_Day_HH_00_00.wav`, and the plan of a simulated dataset (classes,
 //! scenes, lamps and start times of its recordings).
 
+use eenf_core::spelling::option;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -265,7 +266,10 @@ fn preset(name: &str) -> Result<(Classes, f64, (u16, u16))> {
                 .collect();
             return Ok((plans, 40.0, (64, 64)));
         }
-        other => bail!("--preset {other:?}: expected ev-enfd, small or lamp-spot"),
+        other => bail!(
+            "{} {other:?}: expected ev-enfd, small or lamp-spot",
+            option("preset")
+        ),
     };
     let mut plans = cycle("static", n[0], &[&[Static]]);
     plans.extend(cycle("dynamic", n[1], dynamic));
@@ -284,7 +288,7 @@ pub fn plan_dataset(
     let (classes, preset_duration, preset_res) = preset(&spec.preset)?;
     let duration = spec.duration_s.unwrap_or(preset_duration);
     if !(20.0..=3600.0).contains(&duration) {
-        bail!("--duration must be between 20 and 3600 s");
+        bail!("{} must be between 20 and 3600 s", option("duration"));
     }
     let (width, height) = spec.resolution.unwrap_or(preset_res);
     let (lo, hi) = (from.ceil() as i64 + 30, (to - duration).floor() as i64 - 30);

@@ -8,6 +8,7 @@
 //! jump, strength and false-alarm rate, the stretches where the hum is too weak to tell, and
 //! the series a figure needs.
 
+use eenf_core::spelling::option;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
@@ -475,9 +476,10 @@ pub fn trace_edits(trace: &Trace, path: &Path, params: &EditParams) -> Result<Ed
 
 fn too_short(path: &Path, duration_s: f64, params: &EditParams) -> anyhow::Error {
     anyhow!(
-        "{}: the recording lasts {duration_s:.2} s; the phase test needs at least {:.1} s (twice --min-gap)",
+        "{}: the recording lasts {duration_s:.2} s; the phase test needs at least {:.1} s (twice {})",
         path.display(),
-        2.0 * params.min_gap_s
+        2.0 * params.min_gap_s,
+        option("min_gap")
     )
 }
 

@@ -2,6 +2,7 @@
 //! WAV, a dataset's hourly WAVs), how the two are aligned, and the metrics. Shared by
 //! `compare` and `bench`, so both give the same numbers.
 
+use eenf_core::spelling::option;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -91,13 +92,14 @@ impl Reference {
             (Some(hour), Some(start)) if offset_s == 0.0 => {
                 if start.hour_index() != hour.hour_index() {
                     bail!(
-                        "{}: the recording {} starts at {} {:02}:{:02}:{:02}, outside this hour's reference (pass the folder of hourly WAVs, or --offset-s)",
+                        "{}: the recording {} starts at {} {:02}:{:02}:{:02}, outside this hour's reference (pass the folder of hourly WAVs, or {})",
                         path.display(),
                         recording.display(),
                         start.date(),
                         start.hour(),
                         start.second_of_hour() / 60,
-                        start.second_of_hour() % 60
+                        start.second_of_hour() % 60,
+                        option("offset_s")
                     );
                 }
                 Ok((

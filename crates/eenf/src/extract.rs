@@ -1,5 +1,6 @@
 //! E-ENF: an event recording → its polarity sequence → a [`Trace`].
 
+use eenf_core::spelling::option;
 use std::path::Path;
 
 use anyhow::{bail, Result};
@@ -193,8 +194,9 @@ pub fn sample_recording(
         }
         let (camera, _) = best.unwrap_or((0, 0.0));
         let note = format!(
-            "{cameras} cameras: camera {camera} traced, its flicker stands highest ({}); --camera picks another",
-            heard.join("; ")
+            "{cameras} cameras: camera {camera} traced, its flicker stands highest ({}); {} picks another",
+            heard.join("; "),
+            option("camera")
         );
         let open = OpenOptions {
             camera: Some(camera),

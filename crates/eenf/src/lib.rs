@@ -33,6 +33,7 @@ pub mod flicker_map;
 pub mod inspect;
 pub mod locate;
 pub mod mains;
+pub mod options;
 pub mod output;
 pub mod progress;
 pub mod recording;

@@ -1,5 +1,6 @@
 //! `match`: where a trace fits in long references, and when it was therefore recorded.
 
+use eenf_core::spelling::option;
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
@@ -106,8 +107,12 @@ pub fn match_trace_in(
                 let at = if r.absolute {
                     crate::time::parse_time(t)?
                 } else {
-                    t.parse::<f64>()
-                        .context("--verify with a relative reference takes seconds")?
+                    t.parse::<f64>().with_context(|| {
+                        format!(
+                            "{} with a relative reference takes seconds",
+                            option("verify")
+                        )
+                    })?
                 };
                 let k = ((at - r.start) / r.step).round();
                 (k >= 0.0).then_some(k as usize)

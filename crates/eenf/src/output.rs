@@ -75,7 +75,12 @@ impl AtomicFile {
             _ => path.to_path_buf(),
         };
         if target.is_dir() {
-            bail!("{}: is a folder, not a file", path.display());
+            // an OS error of its kind, so that each front end can say what it is
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                format!("{}: is a folder, not a file", path.display()),
+            )
+            .into());
         }
         if path.as_os_str().to_string_lossy().ends_with('/') {
             bail!(

@@ -12,6 +12,7 @@
 //! their whole read-merge-write, so that two builds into one store follow each other; readers
 //! take it shared.
 
+use eenf_core::spelling::switch;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
@@ -76,8 +77,9 @@ impl StoreLock {
                 file.lock().with_context(|| format!("{}", path.display()))?;
             }
             Err(std::fs::TryLockError::WouldBlock) => bail!(
-                "{}: another build is changing this store (without --no-wait, this one waits)",
-                dir.display()
+                "{}: another build is changing this store (without {}, this one waits)",
+                dir.display(),
+                switch("no_wait")
             ),
             Err(std::fs::TryLockError::Error(e)) => {
                 return Err(e).with_context(|| format!("{}", path.display()))

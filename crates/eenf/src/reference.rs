@@ -2,6 +2,7 @@
 //! mains WAVs, one WAV, a trace file), the reference of one recording from a dataset's hourly
 //! WAVs, and the long series that `match` searches.
 
+use eenf_core::spelling::{option, option_with};
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -160,13 +161,15 @@ pub fn wav_start(path: &Path, zone: Option<&Zone>) -> Result<f64> {
     let Some(zone) = zone else {
         bail!(
             "{}: its name gives a local time ({}-{:02}-{:02} {:02}:00) but not its zone: give the \
-             zone with --tz (e.g. --tz Asia/Shanghai or +08:00 where it was recorded in China, \
-             --tz Z for UTC)",
+             zone with {} (e.g. {} or +08:00 where it was recorded in China, {} for UTC)",
             path.display(),
             t.year(),
             t.month(),
             t.day(),
-            t.hour()
+            t.hour(),
+            option("tz"),
+            option_with("tz", "Asia/Shanghai"),
+            option_with("tz", "Z")
         );
     };
     match zone.instant(t.local_seconds()) {
@@ -502,8 +505,9 @@ pub fn build_store(
             let trace = read_series(path, build.index_step_s)?;
             let start = at.or(next_start).with_context(|| {
                 format!(
-                    "{}: give its start as FILE@TIME or with --start",
-                    path.display()
+                    "{}: give its start as FILE@TIME or with {}",
+                    path.display(),
+                    option("start")
                 )
             })?;
             let f0 = nominal_of(&trace, path)?;
@@ -568,8 +572,9 @@ fn read_series(path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
     if index_step_s.is_none() && !header.contains("time_s") {
         bail!(
             "{}: neither an eenf trace (time_s,enf_hz) nor a grid archive (dates or Unix times \
-             and frequencies): an index,value CSV needs --index-step (seconds between values)",
-            path.display()
+             and frequencies): an index,value CSV needs {} (seconds between values)",
+            path.display(),
+            option("index_step")
         );
     }
     Trace::parse(&text, path, index_step_s)

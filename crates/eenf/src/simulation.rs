@@ -2,6 +2,7 @@
 //! a trace CSV, mains WAVs), the hourly reference WAVs that go with them, and writing one
 //! recording with its truth and parameters.
 
+use eenf_core::spelling::option;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -368,17 +369,18 @@ pub fn parse_cameras(list: &str, scale: f64) -> anyhow::Result<Vec<eenf_sim::Cam
             let (name, own) = match item.trim().split_once('@') {
                 Some((n, f)) => (
                     n,
-                    f.parse::<f64>()
-                        .map_err(|_| anyhow::anyhow!("--video {item:?}: bad scale {f:?}"))?,
+                    f.parse::<f64>().map_err(|_| {
+                        anyhow::anyhow!("{} {item:?}: bad scale {f:?}", option("video"))
+                    })?,
                 ),
                 None => (item.trim(), scale),
             };
             if !(own > 0.0 && own <= 1.0) {
-                anyhow::bail!("--video-scale must lie in (0, 1], not {own}");
+                anyhow::bail!("{} must lie in (0, 1], not {own}", option("video_scale"));
             }
             eenf_sim::CameraConfig::named(name)
                 .map(|c| c.scaled(own))
-                .ok_or_else(|| anyhow::anyhow!("--video {name:?}: expected lr or hr"))
+                .ok_or_else(|| anyhow::anyhow!("{} {name:?}: expected lr or hr", option("video")))
         })
         .collect()
 }
@@ -528,7 +530,7 @@ fn local_start(start: &str, source: Option<&Path>, source_start: f64) -> Result<
     if let Some(t) = source.and_then(crate::dataset::reference_hour) {
         return Ok((t.local_seconds() as f64 + source_start, tz));
     }
-    let utc = parse_time(start).context("--start")?;
+    let utc = parse_time(start).with_context(|| option("start"))?;
     Ok((utc + tz, tz))
 }
 
@@ -538,7 +540,7 @@ pub fn recipe_timeline(r: &Recipe) -> Result<(EnfTimeline, f64, f64)> {
     match &r.enf {
         EnfSource::Synthetic(grid) => {
             if *grid != 50.0 && *grid != 60.0 {
-                bail!("--grid must be 50 or 60");
+                bail!("{} must be 50 or 60", option("grid"));
             }
             let (start, tz) = local_start(&r.start, None, 0.0)?;
             let seed = r.config.seed ^ 0x5eed;

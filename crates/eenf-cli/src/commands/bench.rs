@@ -27,7 +27,7 @@ pub struct Args {
     #[arg(long)]
     pub methods: Option<String>,
     /// Recordings processed at once (default: one per core, fewer if the memory budget says so).
-    #[arg(long, value_parser = crate::args::count_in(1, 256))]
+    #[arg(long, value_parser = crate::args::count_in((1, 256)))]
     pub jobs: Option<usize>,
     /// Memory budget, MiB: bounds the recordings processed at once.
     #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u64).range(64..=1 << 30))]

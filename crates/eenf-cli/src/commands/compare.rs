@@ -23,11 +23,11 @@ pub struct Args {
     pub reference: PathBuf,
     /// Seconds to add to the estimate's times to reach the reference's times. Against one
     /// hourly WAV or a folder of them, the default places the recording by its `dvSave-…` name.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = crate::args::number_in(-1e9, 1e9))]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = crate::args::number_in((-1e9, 1e9)))]
     pub offset_s: f64,
     /// Seconds between the rows of an `index,value` CSV (estimate or reference), such as the
     /// published 60 Hz ENF traces.
-    #[arg(long, default_value_t = eenf::trace::INDEX_STEP_S, value_parser = crate::args::number_in(0.001, 3600.0))]
+    #[arg(long, default_value_t = eenf::trace::INDEX_STEP_S, value_parser = crate::args::number_in(eenf::options::limits::INDEX_STEP_S))]
     pub index_step: f64,
     /// Print JSON instead of text.
     #[arg(long)]

@@ -21,7 +21,7 @@ pub struct Args {
     #[arg(long, default_value = "eenf-demo")]
     pub out_dir: PathBuf,
     /// Length of the simulated recording, s.
-    #[arg(long, default_value_t = 60.0, value_parser = crate::args::number_in(1.0, 3600.0))]
+    #[arg(long, default_value_t = 60.0, value_parser = crate::args::number_in((1.0, 3600.0)))]
     pub duration: f64,
     /// Random seed.
     #[arg(long, default_value_t = 1)]

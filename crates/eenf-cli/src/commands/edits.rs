@@ -32,7 +32,7 @@ pub struct Args {
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let started = std::time::Instant::now();
     let spin = progress.spinner("testing the hum's phase");
-    let report = file_edits(&a.file, &a.edit.options(), &progress)?;
+    let report = file_edits(&a.file, &a.edit.options()?, &progress)?;
     spin.finish_and_clear();
     for w in &report.warnings {
         eprintln!("warning: {w}");

@@ -33,7 +33,7 @@ pub struct Args {
 /// Runs `eenf match`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
     let trace = Trace::read(&a.trace, None)?;
-    let query = a.search.query();
+    let query = a.search.query()?;
     let located = locate(
         &trace,
         &a.trace,

@@ -14,7 +14,8 @@ use eenf::time::{tz_offset, LocalTime};
 use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;
 
-use crate::args::{one_of, parse_readout, parse_resolution, VideoArgs};
+use crate::args::{one_of, VideoArgs};
+use eenf::options::simulate::{parse_readout, parse_resolution};
 
 /// Arguments of `eenf simulate-dataset`.
 #[derive(Debug, Clone, clap::Args)]
@@ -48,7 +49,7 @@ pub struct Args {
     #[arg(long)]
     pub resolution: Option<String>,
     /// Length of every recording, s (default: the preset's).
-    #[arg(long, value_parser = crate::args::number_in(0.01, 86_400.0))]
+    #[arg(long, value_parser = crate::args::number_in(eenf::options::limits::DURATION_S))]
     pub duration: Option<f64>,
     /// Readout: dvxplorer, prophesee or dvs128 (the `lamp-spot` preset sets its own).
     #[arg(long, default_value = "dvxplorer")]

@@ -12,6 +12,7 @@ mod cli_edits;
 mod cli_end_to_end;
 mod cli_errors;
 mod cli_flags;
+mod cli_option_docs;
 mod cli_reliability;
 mod cli_simulation;
 mod memory_inputs;

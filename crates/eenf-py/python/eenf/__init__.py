@@ -19,6 +19,7 @@ keyword arguments (``window``), not the command line's flags. A recording read o
 from __future__ import annotations
 
 import json
+import math
 import os
 import warnings
 from typing import Any, Dict, Iterator, List, NamedTuple, Optional, Tuple, Union
@@ -71,23 +72,24 @@ def _is_path(x: Any) -> bool:
     return isinstance(x, (str, bytes, os.PathLike))
 
 
-def _flags(params: Dict[str, Any]) -> List[str]:
-    """Keyword arguments as the command line's flags: ``half_band=1.5`` → ``--half-band=1.5``;
-    ``True`` is a bare flag, ``None`` and ``False`` leave the default."""
-    argv = []
+def _options(params: Dict[str, Any]) -> str:
+    """Keyword arguments as the JSON object the library's option sets take: ``None`` leaves
+    the default; a list becomes comma-separated text (``video=["lr", "hr"]``); a path its
+    text; a non-finite float its name, for the range check to refuse by name."""
+    out: Dict[str, Any] = {}
     for k, v in params.items():
-        if v is None or v is False:
+        if v is None:
             continue
-        flag = "--" + k.replace("_", "-")
-        if v is True:
-            argv.append(flag)
-        elif isinstance(v, float):
-            argv.append(f"{flag}={v!r}")
-        elif isinstance(v, (list, tuple)):
-            argv.append(f"{flag}={','.join(str(e) for e in v)}")
-        else:
-            argv.append(f"{flag}={os.fspath(v) if isinstance(v, os.PathLike) else v}")
-    return argv
+        if isinstance(v, (list, tuple)):
+            v = ",".join(str(e) for e in v)
+        elif isinstance(v, os.PathLike):
+            v = os.fspath(v)
+        elif isinstance(v, np.generic):
+            v = v.item()
+        if isinstance(v, float) and not math.isfinite(v):
+            v = repr(v)
+        out[k] = v
+    return json.dumps(out)
 
 
 def _warn(message: Optional[str]) -> None:
@@ -113,7 +115,7 @@ def read_events(
     first event. Reading options (``camera``, ``chip``, ``strict``, ``max_gap``) are those of
     ``eenf info``; see below.
     """
-    records, warning = _eenf.read_events(os.fspath(path), start, end, _flags(params))
+    records, warning = _eenf.read_events(os.fspath(path), start, end, _options(params))
     _warn(warning)
     return records.view(EVENT_DTYPE)
 
@@ -121,7 +123,7 @@ def read_events(
 def iter_events(path: PathLike, batch: int = 1_000_000, **params: Any) -> Iterator[np.ndarray]:
     """Streams the events of a file as structured arrays of at most ``batch`` events each, in
     memory that does not grow with the file. Reading options as for :func:`read_events`."""
-    it = _eenf.EventIterator(os.fspath(path), int(batch), _flags(params))
+    it = _eenf.EventIterator(os.fspath(path), int(batch), _options(params))
     while True:
         try:
             records, warning = it.next()
@@ -135,7 +137,7 @@ def iter_events(path: PathLike, batch: int = 1_000_000, **params: Any) -> Iterat
 def info(path: PathLike, **params: Any) -> Dict[str, Any]:
     """What an event file holds, as ``eenf info --json`` reports it: format, codec, size,
     streams, events, span, the sampling E-ENF would use, the flicker line per camera, damage."""
-    return json.loads(_eenf.info(os.fspath(path), _flags(params)))
+    return json.loads(_eenf.info(os.fspath(path), _options(params)))
 
 
 def _field(events: Any, *names: str) -> Optional[np.ndarray]:
@@ -223,7 +225,7 @@ def write_events(
     address + 1. Returns the number of events written."""
     t, x, y, p = _columns(events)
     w, h = _size(x, y, width, height)
-    return _eenf.write_events(os.fspath(path), t, x, y, p, w, h, _flags(params))
+    return _eenf.write_events(os.fspath(path), t, x, y, p, w, h, _options(params))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -393,10 +395,10 @@ def extract(
     address + 1). Events in memory take the same path as a file's, so they give the same trace.
     """
     if _is_path(source):
-        return _trace(_eenf.extract(os.fspath(source), _flags(params)))
+        return _trace(_eenf.extract(os.fspath(source), _options(params)))
     t, x, y, p = _columns(source)
     w, h = _size(x, y, width, height)
-    return _trace(_eenf.extract_events(t, x, y, p, w, h, name, _flags(params)))
+    return _trace(_eenf.extract_events(t, x, y, p, w, h, name, _options(params)))
 
 
 def _frames(source: Any, what: str) -> np.ndarray:
@@ -423,12 +425,12 @@ def reference(
     if _is_path(source):
         if fs is not None:
             raise ValueError("fs is for samples in memory; a file gives its own rate")
-        return _trace(_eenf.reference(os.fspath(source), _flags(params)))
+        return _trace(_eenf.reference(os.fspath(source), _options(params)))
     if fs is None:
         raise TypeError("reference: samples in memory need their rate: fs=...")
     frames = _frames(source, "reference")
     return _trace(
-        _eenf.reference_samples(frames.reshape(-1), frames.shape[1], float(fs), name, _flags(params))
+        _eenf.reference_samples(frames.reshape(-1), frames.shape[1], float(fs), name, _options(params))
     )
 
 
@@ -449,13 +451,13 @@ def edits(
     if _is_path(source):
         if fs is not None:
             raise ValueError("fs is for samples in memory; a file gives its own rate")
-        out = _eenf.edits(os.fspath(source), _flags(params))
+        out = _eenf.edits(os.fspath(source), _options(params))
     else:
         if fs is None:
             raise TypeError("edits: samples in memory need their rate: fs=...")
         frames = _frames(source, "edits")
         out = _eenf.edits_samples(
-            frames.reshape(-1), frames.shape[1], float(fs), name, _flags(params)
+            frames.reshape(-1), frames.shape[1], float(fs), name, _options(params)
         )
     report = json.loads(out[0])
     report["series"] = dict(zip(("time_s", "phase_deg", "strength", "enf_hz"), out[1:]))
@@ -465,7 +467,7 @@ def edits(
 def video(path: PathLike, **params: Any) -> Trace:
     """The V-ENF trace of a conventional video's rolling-shutter flicker (Y4M natively, other
     containers through ffmpeg)."""
-    return _trace(_eenf.video(os.fspath(path), _flags(params)))
+    return _trace(_eenf.video(os.fspath(path), _options(params)))
 
 
 class Comparison(NamedTuple):
@@ -527,7 +529,7 @@ def match(trace: Any, reference: PathLike, top: int = 5, **params: Any) -> Dict[
     MAE, p-value), and with ``verify=TIME`` how the claimed time fits."""
     native, name = _as_trace(trace)
     return json.loads(
-        _eenf.match_trace(native, name, os.fspath(reference), _flags({"top": top, **params}))
+        _eenf.match_trace(native, name, os.fspath(reference), _options({"top": top, **params}))
     )
 
 
@@ -538,7 +540,7 @@ def refdb_build(store: PathLike, *inputs: PathLike, **params: Any) -> Dict[str, 
     ``"+08:00"``, ``"Z"``): none is assumed. Returns the ``grids`` changed (name, values) and,
     for each archive, its ``summary`` and ``report`` (layout, zone, rows read and dropped)."""
     return json.loads(
-        _eenf.refdb_build(os.fspath(store), [os.fspath(i) for i in inputs], _flags(params))
+        _eenf.refdb_build(os.fspath(store), [os.fspath(i) for i in inputs], _options(params))
     )
 
 
@@ -561,7 +563,7 @@ def simulate(output: Optional[PathLike] = None, **params: Any) -> Simulation:
     the truth as a :class:`Trace`."""
     if output is not None:
         params = {"output": os.fspath(output), **params}
-    r = json.loads(_eenf.simulate(_flags(params)))
+    r = json.loads(_eenf.simulate(_options(params)))
     return Simulation(
         recording=r["recording"],
         truth=Trace.read(r["truth"]),
@@ -581,16 +583,16 @@ def simulate(output: Optional[PathLike] = None, **params: Any) -> Simulation:
 def _document(fn: Any, *sets: str) -> None:
     lines = ["", "Keyword parameters (the command line's flags, with their defaults):", ""]
     for s in sets:
-        for name, default, help_text, choices in _eenf.options(s):
-            head = f"{name}"
-            if choices == ["true", "false"]:
+        for o in json.loads(_eenf.options(s)):
+            head = o["name"]
+            if o["switch"]:
                 head += " (True or False, default False)"
             else:
-                if default is not None:
-                    head += f" (default {default})"
-                if choices:
-                    head += f"; one of {', '.join(choices)}"
-            body = " ".join(help_text.split())
+                if o["default"] is not None:
+                    head += f" (default {o['default']})"
+                if o["choices"]:
+                    head += f"; one of {', '.join(o['choices'])}"
+            body = " ".join(o["help"].split())
             lines.append(f"    {head}")
             lines.append(f"        {body}")
     fn.__doc__ = (fn.__doc__ or "") + "\n".join(lines) + "\n"

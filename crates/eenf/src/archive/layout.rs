@@ -1,6 +1,7 @@
 //! An archive's layout, told from its first lines: separator, header, the columns giving a
 //! row's time and its value, the value's unit, the decimal mark, the date order and the zone.
 
+use eenf_core::spelling::{option, option_with};
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
@@ -107,8 +108,8 @@ impl Layout {
         match &self.zone {
             ZoneRule::InRows => "with their own UTC offsets".into(),
             ZoneRule::Utc(why) => format!("in {why}"),
-            ZoneRule::Given(z) if z.name() == "UTC" => "in UTC (--tz)".into(),
-            ZoneRule::Given(z) => format!("local to {} (--tz)", z.name()),
+            ZoneRule::Given(z) if z.name() == "UTC" => format!("in UTC ({})", option("tz")),
+            ZoneRule::Given(z) => format!("local to {} ({})", z.name(), option("tz")),
         }
     }
 
@@ -173,7 +174,9 @@ impl Layout {
                 }
             }
             _ => bail!(
-                "{label}: its values are deviations from the nominal frequency: give it with --nominal 50 or --nominal 60"
+                "{label}: its values are deviations from the nominal frequency: give it with {} or {}",
+                option_with("nominal", "50"),
+                option_with("nominal", "60")
             ),
         }
     }
@@ -432,9 +435,10 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
                 ValueUnit::HzDeviation
             } else {
                 bail!(
-                    "{name}: column {} ({:?}) is not near 50 or 60 Hz and its header does not say it is a deviation: give --value-unit hz, mhz-deviation or hz-deviation",
+                    "{name}: column {} ({:?}) is not near 50 or 60 Hz and its header does not say it is a deviation: give {} hz, mhz-deviation or hz-deviation",
                     value + 1,
-                    names[value]
+                    names[value],
+                    option("value_unit")
                 );
             }
         }
@@ -474,8 +478,9 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
                 DateOrder::Dmy // 17.08.2022: the dotted style is day first wherever it is used
             } else {
                 bail!(
-                    "{name}: dates such as {:?} can be read day/month or month/day: give --date-order dmy or mdy",
-                    String::from_utf8_lossy(field(c))
+                    "{name}: dates such as {:?} can be read day/month or month/day: give {} dmy or mdy",
+                    String::from_utf8_lossy(field(c)),
+                    option("date_order")
                 );
             };
         }
@@ -507,8 +512,9 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
         ZoneRule::Utc(why)
     } else {
         bail!(
-            "{name}: its times ({:?}) carry no zone and none is assumed: give it with --tz ({})",
+            "{name}: its times ({:?}) carry no zone and none is assumed: give it with {} ({})",
             String::from_utf8_lossy(field(date_col.unwrap_or(0))),
+            option("tz"),
             format.zone_hint()
         );
     };

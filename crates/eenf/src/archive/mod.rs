@@ -18,6 +18,7 @@
 //! interpolated between neighbouring rows, and values outside the grid's operating range
 //! (0 Hz dropouts, say) are dropped as gaps and counted.
 
+use eenf_core::spelling::option_with;
 use std::fmt;
 use std::fs::File;
 use std::io::{BufReader, Read};
@@ -102,11 +103,30 @@ impl ArchiveFormat {
     }
 
     /// The zone to suggest when a file of this layout needs one.
-    fn zone_hint(self) -> &'static str {
+    fn zone_hint(self) -> String {
+        let tz = |zone: &str| option_with("tz", zone);
         match self {
-            ArchiveFormat::Fingrid => "--tz Europe/Helsinki for Finnish time, --tz Z for UTC",
-            ArchiveFormat::Transnetbw => "--tz Europe/Berlin for German time, --tz Z for UTC",
-            _ => "e.g. --tz Europe/Berlin, --tz America/New_York, --tz +08:00, or --tz Z for UTC",
+            ArchiveFormat::Fingrid => {
+                format!(
+                    "{} for Finnish time, {} for UTC",
+                    tz("Europe/Helsinki"),
+                    tz("Z")
+                )
+            }
+            ArchiveFormat::Transnetbw => {
+                format!(
+                    "{} for German time, {} for UTC",
+                    tz("Europe/Berlin"),
+                    tz("Z")
+                )
+            }
+            _ => format!(
+                "e.g. {}, {}, {}, or {} for UTC",
+                tz("Europe/Berlin"),
+                tz("America/New_York"),
+                tz("+08:00"),
+                tz("Z")
+            ),
         }
     }
 

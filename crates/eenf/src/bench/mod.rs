@@ -9,6 +9,7 @@ pub mod run;
 pub mod settings;
 
 use anyhow::{bail, Result};
+use eenf_core::spelling::option;
 use serde::Serialize;
 
 pub use discover::{class_rank, discover, group_by_prominence, Recording, PROMINENCE_BANDS};
@@ -56,13 +57,13 @@ impl Method {
         for name in s.split(',').map(str::trim).filter(|n| !n.is_empty()) {
             let m: Method = name
                 .parse()
-                .map_err(|e| anyhow::anyhow!("--methods: {e}"))?;
+                .map_err(|e| anyhow::anyhow!("{}: {e}", option("methods")))?;
             if !out.contains(&m) {
                 out.push(m);
             }
         }
         if out.is_empty() {
-            bail!("--methods: no method given");
+            bail!("{}: no method given", option("methods"));
         }
         out.sort_by_key(|m| Method::ALL.iter().position(|a| a == m));
         Ok(out)

@@ -1,6 +1,7 @@
 //! The settings of a benchmark run, and `--sweep key=v1,v2,…` ablations over them.
 
 use anyhow::{bail, Context, Result};
+use eenf_core::spelling::option;
 use eenf_video::VideoOptions;
 
 use crate::extract::ExtractOptions;
@@ -32,7 +33,7 @@ impl Settings {
 
     /// Sets `key` to `value` (enum values parsed as the command line parses them).
     fn set(&mut self, key: &str, value: &str) -> Result<()> {
-        let bad = || anyhow::anyhow!("--sweep {key}={value}: not a valid value");
+        let bad = || anyhow::anyhow!("{} {key}={value}: not a valid value", option("sweep"));
         let p = &mut self.extract.params;
         match key {
             "harmonics" => p.harmonics = value.parse().ok().filter(|h| *h >= 1).ok_or_else(bad)?,
@@ -71,7 +72,8 @@ impl Settings {
             "scene-removal" => self.video.scene_removal = value.parse().map_err(|_| bad())?,
             "video-sampling" => self.video.sampling = value.parse().map_err(|_| bad())?,
             _ => bail!(
-                "--sweep {key}: unknown setting (harmonics, sampling, peak, window, dt-us, selection, tiles, segment, median-len, scene-removal, video-sampling)"
+                "{} {key}: unknown setting (harmonics, sampling, peak, window, dt-us, selection, tiles, segment, median-len, scene-removal, video-sampling)",
+                option("sweep")
             ),
         }
         self.label.push((key.to_string(), value.to_string()));
@@ -86,14 +88,14 @@ pub fn sweep(base: &Settings, sweeps: &[String]) -> Result<Vec<Settings>> {
     for s in sweeps {
         let (key, values) = s
             .split_once('=')
-            .with_context(|| format!("--sweep {s:?}: expected key=value,value,…"))?;
+            .with_context(|| format!("{} {s:?}: expected key=value,value,…", option("sweep")))?;
         let values: Vec<&str> = values
             .split(',')
             .map(str::trim)
             .filter(|v| !v.is_empty())
             .collect();
         if values.is_empty() {
-            bail!("--sweep {s:?}: no values");
+            bail!("{} {s:?}: no values", option("sweep"));
         }
         let mut next = Vec::new();
         for settings in &out {

@@ -83,7 +83,10 @@ fn layouts_are_sniffed() {
     let e = layout("time,frequency\n2024-08-19 15:26:02,49.978\n", &o)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("x.csv") && e.contains("--tz"), "{e}");
+    assert!(
+        e.contains("x.csv") && e.contains("give it with tz ("),
+        "{e}"
+    );
     let berlin = ArchiveOptions {
         zone: Some(Zone::parse("Europe/Berlin").unwrap()),
         ..o.clone()
@@ -120,7 +123,7 @@ fn layouts_are_sniffed() {
     let e = layout("when,f\n05/06/2022 00:00:00,50.0\n", &berlin)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("--date-order"), "{e}");
+    assert!(e.contains("give date_order dmy or mdy"), "{e}");
     let e = layout("a,b\n1,2\n3,4\n", &o).unwrap_err().to_string();
     assert!(e.contains("no time column") && e.contains("x.csv"), "{e}");
     let e = layout("just some text\n", &o).unwrap_err().to_string();
@@ -128,7 +131,7 @@ fn layouts_are_sniffed() {
     let e = layout("time,level\n2024-08-19 15:26:02,3.0\n", &berlin)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("--value-unit"), "{e}");
+    assert!(e.contains("give value_unit hz"), "{e}");
 }
 
 #[test]

@@ -1,0 +1,230 @@
+//! Option sets: what a front end asks of the library, as plain data that checks itself.
+//!
+//! Each set holds its options under their library names (`window`, `max_gap`) with their
+//! defaults (from [`eenf_core::defaults`] and the library's own), and [`OptionSet::check`]
+//! refuses a value outside its range ([`limits`]) or a combination that cannot work, before any
+//! work or allocation is sized by it. Then the set turns into the library's parameters
+//! (`ExtractSettings::options` gives an [`crate::extract::ExtractOptions`], ...).
+//!
+//! The front ends fill the sets their own way: the command line from clap's flags
+//! (`eenf-cli/src/args.rs`), Python and a page from a JSON object of keyword arguments
+//! ([`apply_json`]). Messages name options as [`eenf_core::spelling`] says the front end's
+//! users write them.
+
+pub mod events;
+pub mod limits;
+pub mod simulate;
+pub mod sound;
+
+use std::fmt;
+use std::str::FromStr;
+
+use eenf_core::spelling::{option, spelling, Spelling};
+use serde_json::Value;
+
+pub use events::{EventOutputSettings, ExtractSettings, InputSettings, TrackerSettings};
+pub use simulate::{SimulateSettings, VideoRenderSettings};
+pub use sound::{AudioSettings, EditSettings, MatchSettings, StoreInputSettings, VideoSettings};
+
+/// Why an option set was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OptionError {
+    /// A name that none of the sets has.
+    #[error("{}", unknown_words(.0))]
+    Unknown(String),
+    /// A value that cannot be read as its option's type, or lies outside its range.
+    #[error("{}", invalid_words(.name, .value, .reason))]
+    Invalid {
+        /// The option's library name.
+        name: &'static str,
+        /// The value given, as text.
+        value: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A value that breaks a rule about it or about another option.
+    #[error("{rule}")]
+    Rule {
+        /// The option's library name.
+        name: &'static str,
+        /// The rule, in words (options named by the spelling in force).
+        rule: String,
+    },
+    /// Options given as something other than a JSON object of names and values.
+    #[error("options must be a JSON object of names and values: {0}")]
+    NotAnObject(String),
+}
+
+fn unknown_words(name: &str) -> String {
+    match spelling() {
+        Spelling::Keywords => format!("unexpected keyword argument '{name}'"),
+        Spelling::Flags => format!("unexpected argument '{}'", option(name)),
+        Spelling::Fields => format!("unexpected field '{name}'"),
+    }
+}
+
+fn invalid_words(name: &str, value: &str, reason: &str) -> String {
+    format!("invalid value '{value}' for '{}': {reason}", option(name))
+}
+
+impl OptionError {
+    /// The library name of the option it is about (none for an unknown name).
+    pub fn option(&self) -> Option<&str> {
+        match self {
+            OptionError::Unknown(n) => Some(n),
+            OptionError::Invalid { name, .. } | OptionError::Rule { name, .. } => Some(name),
+            OptionError::NotAnObject(_) => None,
+        }
+    }
+}
+
+/// A set of options that a front end fills by name and the library checks.
+pub trait OptionSet: fmt::Debug {
+    /// Sets option `name` from a JSON value (a number, text, true/false or null for "not
+    /// given"); `Ok(false)` when the set has no option of that name.
+    fn set(&mut self, name: &str, value: &Value) -> Result<bool, OptionError>;
+    /// Refuses values outside their range and combinations that cannot work.
+    fn check(&self) -> Result<(), OptionError>;
+}
+
+/// Fills `sets` from a JSON object of options (each name goes to the first set that has it),
+/// then checks each set. A name no set has is an [`OptionError::Unknown`].
+pub fn apply_json(sets: &mut [&mut dyn OptionSet], json: &str) -> Result<(), OptionError> {
+    let value: Value =
+        serde_json::from_str(json).map_err(|e| OptionError::NotAnObject(e.to_string()))?;
+    let Value::Object(map) = value else {
+        return Err(OptionError::NotAnObject(format!("got {value}")));
+    };
+    for (name, v) in &map {
+        let mut taken = false;
+        for s in sets.iter_mut() {
+            if s.set(name, v)? {
+                taken = true;
+                break;
+            }
+        }
+        if !taken {
+            return Err(OptionError::Unknown(name.clone()));
+        }
+    }
+    sets.iter().try_for_each(|s| s.check())
+}
+
+/// `v` as text: a string as it is, anything else as its JSON.
+fn text_of(v: &Value) -> String {
+    match v {
+        Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+fn invalid(name: &'static str, v: &Value, reason: impl Into<String>) -> OptionError {
+    OptionError::Invalid {
+        name,
+        value: text_of(v),
+        reason: reason.into(),
+    }
+}
+
+/// A number (or text that reads as one: `"nan"` and `"inf"` too, for the range check to
+/// refuse by name).
+pub(crate) fn number(name: &'static str, v: &Value) -> Result<f64, OptionError> {
+    match v {
+        Value::Number(n) => n.as_f64(),
+        Value::String(s) => s.trim().parse().ok(),
+        _ => None,
+    }
+    .ok_or_else(|| invalid(name, v, "not a number"))
+}
+
+/// A whole number of type `T` (a JSON integer, or text that reads as one).
+pub(crate) fn whole<T: TryFrom<i128>>(name: &'static str, v: &Value) -> Result<T, OptionError> {
+    let n: Option<i128> = match v {
+        Value::Number(n) => n.as_i64().map(i128::from).or(n.as_u64().map(i128::from)),
+        Value::String(s) => s.trim().parse().ok(),
+        _ => None,
+    };
+    let n = n.ok_or_else(|| invalid(name, v, "not a whole number"))?;
+    T::try_from(n).map_err(|_| invalid(name, v, "out of range"))
+}
+
+/// true or false.
+pub(crate) fn switch(name: &'static str, v: &Value) -> Result<bool, OptionError> {
+    v.as_bool()
+        .ok_or_else(|| invalid(name, v, "expected true or false"))
+}
+
+/// Text (a number is taken as its digits: `nominal=50`).
+pub(crate) fn text(name: &'static str, v: &Value) -> Result<String, OptionError> {
+    match v {
+        Value::String(_) | Value::Number(_) => Ok(text_of(v)),
+        _ => Err(invalid(name, v, "expected text")),
+    }
+}
+
+/// A value named by text, read by the type's `FromStr` (the names the command line takes).
+pub(crate) fn named<T: FromStr>(name: &'static str, v: &Value) -> Result<T, OptionError>
+where
+    T::Err: fmt::Display,
+{
+    text(name, v)?
+        .parse()
+        .map_err(|e: T::Err| invalid(name, v, e.to_string()))
+}
+
+/// `None` for null, else the value read by `read`.
+pub(crate) fn maybe<T>(
+    name: &'static str,
+    v: &Value,
+    read: fn(&'static str, &Value) -> Result<T, OptionError>,
+) -> Result<Option<T>, OptionError> {
+    match v {
+        Value::Null => Ok(None),
+        _ => read(name, v).map(Some),
+    }
+}
+
+/// Refuses `v` outside `lo..=hi` (NaN and infinities too).
+pub(crate) fn within(name: &'static str, v: f64, (lo, hi): (f64, f64)) -> Result<(), OptionError> {
+    if v.is_finite() && (lo..=hi).contains(&v) {
+        Ok(())
+    } else {
+        Err(OptionError::Invalid {
+            name,
+            value: v.to_string(),
+            reason: format!("{v} is outside {lo}..={hi}"),
+        })
+    }
+}
+
+/// Refuses a whole number outside `lo..=hi`.
+pub(crate) fn counted<T: Into<i128> + Copy + fmt::Display>(
+    name: &'static str,
+    v: T,
+    (lo, hi): (T, T),
+) -> Result<(), OptionError> {
+    if (lo.into()..=hi.into()).contains(&v.into()) {
+        Ok(())
+    } else {
+        Err(OptionError::Invalid {
+            name,
+            value: v.to_string(),
+            reason: format!("{v} is outside {lo}..={hi}"),
+        })
+    }
+}
+
+/// A broken rule about option `name`.
+pub(crate) fn rule(name: &'static str, rule: impl Into<String>) -> OptionError {
+    OptionError::Rule {
+        name,
+        rule: rule.into(),
+    }
+}
+
+/// Each option set's options, as JSON: `{"extract": [{"name", "default", "help",
+/// "choices"}, ...], ...}` (the sets: input, extract, reference, video, simulate, match, write,
+/// edits, refdb_build). Written from the command line's flags, whose doc comments hold the
+/// help, and kept equal to them by a test of `eenf-cli`; Python's docstrings and the page's
+/// forms read it.
+pub const DOCS_JSON: &str = include_str!("docs.json");
