@@ -34,6 +34,8 @@ COMMANDS = [
     "match t.csv refs --tz +08:00 --json --top 3",
     "match t.csv refs --tz +08:00 --verify 2022-08-17T16:10:00+08:00",
     "edits tb.json --json",
+    "simulate-dataset ds --preset small --duration 20 --resolution 32x24 --video lr --video-scale 0.25",
+    "simulate-dataset ds2 --preset small --grid 55", "simulate-dataset ds3 --start tomorrow",
     # sound and references
     f"reference {S}/fixtures/real-audio/pyenf_room_16s.wav --json",
     f"audio {S}/fixtures/real-audio/pyenf_room_34s.wav --harmonics 2 -o a.csv --plot a.svg",
