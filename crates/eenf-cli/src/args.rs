@@ -720,7 +720,7 @@ pub fn option_docs() -> serde_json::Value {
     use clap::Args as _;
     /// Adds an option set's flags to a command.
     type Augment = fn(clap::Command) -> clap::Command;
-    let sets: [(&str, Augment); 9] = [
+    let sets: [(&str, Augment); 10] = [
         ("input", InputArgs::augment_args),
         ("extract", MethodArgs::augment_args),
         ("reference", |c| {
@@ -728,6 +728,10 @@ pub fn option_docs() -> serde_json::Value {
         }),
         ("video", VideoMethodArgs::augment_args),
         ("simulate", SimulateArgs::augment_args),
+        (
+            "simulate_dataset",
+            crate::commands::simulate_dataset::Args::augment_args,
+        ),
         ("match", MatchArgs::augment_args),
         ("write", EventOutputArgs::augment_args),
         ("edits", EditArgs::augment_args),

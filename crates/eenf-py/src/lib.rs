@@ -593,6 +593,28 @@ fn simulate(py: Python<'_>, options: &str) -> PyResult<String> {
     .map_err(py_err)
 }
 
+/// `eenf simulate-dataset`: builds a simulated dataset into `out_dir`; returns what was
+/// written, as JSON text. The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (out_dir, options="{}"))]
+fn simulate_dataset(py: Python<'_>, out_dir: PathBuf, options: &str) -> PyResult<String> {
+    let a: opts::DatasetSettings = settings(options)?;
+    py.detach(|| {
+        let build = a.build(out_dir.clone())?;
+        let mut notes = Vec::new();
+        let built =
+            eenf::dataset::build_dataset(&build, &Progress::hidden(), &mut |n| notes.push(n))?;
+        Ok(serde_json::json!({
+            "out_dir": out_dir,
+            "manifest": out_dir.join("manifest.csv"),
+            "recordings": built.recordings, "events": built.events,
+            "references": built.references, "notes": notes,
+        })
+        .to_string())
+    })
+    .map_err(py_err)
+}
+
 /// Writes events (columns, checked) to `path` whole or not at all (`eenf convert`'s writers);
 /// returns the number written. The GIL is released.
 #[pyfunction]
@@ -713,6 +735,7 @@ fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(plot_trace, m)?)?;
     m.add_function(wrap_pyfunction!(match_trace, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(refdb_build, m)?)?;
     m.add_function(wrap_pyfunction!(write_events, m)?)?;
     m.add_function(wrap_pyfunction!(edits, m)?)?;

@@ -132,3 +132,22 @@ def test_real_recordings_equal_the_command_line(cli, shared):
         got = eenf.extract(path)
         assert same(want["enf_hz"], got.enf_hz), name
         assert got.meta.get("camera") == want.get("camera")
+
+
+def test_simulate_dataset_equals_the_command_line(cli, tmp_path):
+    """The dataset Python builds is the command's, file for file (the same seed, the same
+    bytes), and a refused option leaves no folder behind."""
+    args = dict(preset="small", duration=20, resolution="24x18", seed=7)
+    got = eenf.simulate_dataset(tmp_path / "py", **args)
+    cli("simulate-dataset", tmp_path / "cli", "--preset", "small", "--duration", "20",
+        "--resolution", "24x18", "--seed", "7")
+    assert got["recordings"] == 9 and got["events"] > 0 and got["references"]
+    files = lambda root: sorted(p.relative_to(root) for p in root.rglob("*") if p.is_file())
+    py_files, cli_files = files(tmp_path / "py"), files(tmp_path / "cli")
+    assert py_files == cli_files and len(py_files) > 9 * 2
+    for f in py_files:
+        if f.suffix in (".aedat4", ".wav", ".csv"):
+            assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
+    with pytest.raises(ValueError, match="preset"):
+        eenf.simulate_dataset(tmp_path / "bad", preset="huge")
+    assert not (tmp_path / "bad").exists()

@@ -11,7 +11,7 @@ from eenf import _eenf
 STUB = Path(eenf.__file__).with_name("__init__.pyi")
 SETS = {"read_events": ["input"], "iter_events": ["input"], "info": ["input"],
         "extract": ["extract"], "reference": ["reference"], "video": ["video"],
-        "match": ["match"], "simulate": ["simulate"], "write_events": ["write"],
+        "match": ["match"], "simulate": ["simulate"], "simulate_dataset": ["simulate_dataset"], "write_events": ["write"],
         "edits": ["edits"], "refdb_build": ["refdb_build"]}
 
 

@@ -3,13 +3,11 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use eenf::dataset::{build_dataset, parse_local_hour, DatasetBuild, DatasetEnf, DatasetSpec};
+use eenf::dataset::build_dataset;
 use eenf::progress::Progress;
-use eenf::time::tz_offset;
 use eenf_events::Compression;
 
 use crate::args::{one_of, VideoArgs};
-use eenf::options::simulate::{parse_readout, parse_resolution};
 
 /// Arguments of `eenf simulate-dataset`.
 #[derive(Debug, Clone, clap::Args)]
@@ -58,29 +56,28 @@ pub struct Args {
     pub video: VideoArgs,
 }
 
+impl Args {
+    /// The library's option set.
+    pub fn settings(&self) -> eenf::options::DatasetSettings {
+        eenf::options::DatasetSettings {
+            preset: self.preset.clone(),
+            enf_dir: self.enf_dir.clone(),
+            grid: self.grid,
+            start: self.start.clone(),
+            tz: self.tz.clone(),
+            resolution: self.resolution.clone(),
+            duration: self.duration,
+            readout: self.readout.clone(),
+            compression: self.compression,
+            seed: self.seed,
+            video: self.video.settings(),
+        }
+    }
+}
+
 /// Runs `eenf simulate-dataset`.
 pub fn run(a: Args, progress: Progress) -> Result<()> {
-    let build = DatasetBuild {
-        out_dir: a.out_dir.clone(),
-        spec: DatasetSpec {
-            preset: a.preset.clone(),
-            duration_s: a.duration,
-            resolution: a.resolution.as_deref().map(parse_resolution).transpose()?,
-            readout: parse_readout(&a.readout)?,
-            tz_s: tz_offset(&a.tz)?,
-            seed: a.seed,
-        },
-        enf: match &a.enf_dir {
-            Some(dir) => DatasetEnf::WavDir(dir.clone()),
-            None => DatasetEnf::Synthetic {
-                grid_hz: a.grid as f64,
-                from_local_s: parse_local_hour(&a.start)?,
-            },
-        },
-        compression: a.compression,
-        cameras: a.video.cameras()?,
-        mp4: a.video.mp4,
-    };
+    let build = a.settings().build(a.out_dir.clone())?;
     let built = build_dataset(&build, &progress, &mut |note| eprintln!("{note}"))?;
     eprintln!(
         "{} recordings ({} events, {:.1} M events/s) in {:.0} s -> {}",

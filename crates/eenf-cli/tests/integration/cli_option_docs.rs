@@ -30,6 +30,7 @@ fn library_sets(name: &str) -> Vec<Box<dyn OptionSet>> {
         ],
         "video" => vec![Box::new(options::VideoSettings::default())],
         "simulate" => vec![Box::new(options::SimulateSettings::default())],
+        "simulate_dataset" => vec![Box::new(options::DatasetSettings::default())],
         "match" => vec![Box::new(options::MatchSettings::default())],
         "write" => vec![Box::new(options::EventOutputSettings::default())],
         "edits" => vec![Box::new(options::EditSettings::default())],

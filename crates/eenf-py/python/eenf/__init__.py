@@ -57,6 +57,7 @@ __all__ = [
     "compare",
     "match",
     "simulate",
+    "simulate_dataset",
     "edits",
     "refdb_build",
 ]
@@ -576,6 +577,15 @@ def simulate(output: Optional[PathLike] = None, **params: Any) -> Simulation:
     )
 
 
+def simulate_dataset(out_dir: PathLike, **params: Any) -> Dict[str, Any]:
+    """``eenf simulate-dataset``: builds a simulated dataset laid out like EV-ENFD in
+    ``out_dir`` (``static/``, ``dynamic/``, ``extreme/`` recordings with their truth,
+    ``ENF_Reference/`` hourly WAVs, ``manifest.csv``, ``dataset.json``); a folder made here is
+    removed again if the build fails. Returns the ``manifest`` path, the number of
+    ``recordings`` and ``events``, the ``references`` written and any ``notes``."""
+    return json.loads(_eenf.simulate_dataset(os.fspath(out_dir), _options(params)))
+
+
 # ---------------------------------------------------------------------------------------------
 # docstrings: every keyword parameter with the command line's default and help
 
@@ -606,6 +616,7 @@ _document(reference, "reference")
 _document(video, "video")
 _document(match, "match")
 _document(simulate, "simulate")
+_document(simulate_dataset, "simulate_dataset")
 _document(refdb_build, "refdb_build")
 _document(write_events, "write")
 _document(edits, "edits")

@@ -239,3 +239,20 @@ def simulate(
     video_scale: float = 1.0,
     mp4: bool = False,
 ) -> Simulation: ...
+def simulate_dataset(
+    out_dir: PathLike,
+    *,
+    preset: Literal["ev-enfd", "small", "lamp-spot"] = "ev-enfd",
+    enf_dir: Optional[PathLike] = None,
+    grid: int = 50,
+    start: str = "2022-08-17T16",
+    tz: str = "+08:00",
+    resolution: Optional[str] = None,
+    duration: Optional[float] = None,
+    readout: Literal["dvxplorer", "prophesee", "dvs128"] = "dvxplorer",
+    compression: Compression = "lz4",
+    seed: int = 2023,
+    video: Optional[str] = None,
+    video_scale: float = 1.0,
+    mp4: bool = False,
+) -> Dict[str, Any]: ...

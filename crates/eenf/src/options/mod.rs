@@ -23,7 +23,7 @@ use eenf_core::spelling::{option, spelling, Spelling};
 use serde_json::Value;
 
 pub use events::{EventOutputSettings, ExtractSettings, InputSettings, TrackerSettings};
-pub use simulate::{SimulateSettings, VideoRenderSettings};
+pub use simulate::{DatasetSettings, SimulateSettings, VideoRenderSettings};
 pub use sound::{AudioSettings, EditSettings, MatchSettings, StoreInputSettings, VideoSettings};
 
 /// Why an option set was refused.
@@ -223,8 +223,8 @@ pub(crate) fn rule(name: &'static str, rule: impl Into<String>) -> OptionError {
 }
 
 /// Each option set's options, as JSON: `{"extract": [{"name", "default", "help",
-/// "choices"}, ...], ...}` (the sets: input, extract, reference, video, simulate, match, write,
-/// edits, refdb_build). Written from the command line's flags, whose doc comments hold the
+/// "choices", "switch"}, ...], ...}` (the sets: input, extract, reference, video, simulate,
+/// simulate_dataset, match, write, edits, refdb_build). Written from the command line's flags, whose doc comments hold the
 /// help, and kept equal to them by a test of `eenf-cli`; Python's docstrings and the page's
 /// forms read it.
 pub const DOCS_JSON: &str = include_str!("docs.json");

@@ -336,3 +336,108 @@ pub fn parse_readout(s: &str) -> Result<Readout, OptionError> {
         )
     })
 }
+
+/// The options of a simulated dataset (`simulate-dataset`, Python's `simulate_dataset`).
+#[derive(Debug, Clone)]
+pub struct DatasetSettings {
+    /// `preset`: `ev-enfd`, `small` or `lamp-spot`.
+    pub preset: String,
+    /// `enf_dir`: drive the recordings with these hourly mains WAVs (default: synthetic ENF).
+    pub enf_dir: Option<PathBuf>,
+    /// `grid`: the grid of a synthetic ENF, 50 or 60.
+    pub grid: u32,
+    /// `start`: the local date and hour where a synthetic dataset starts.
+    pub start: String,
+    /// `tz`: the UTC offset of the recordings' local names.
+    pub tz: String,
+    /// `resolution`: every recording's sensor, `WxH` (default: the preset's).
+    pub resolution: Option<String>,
+    /// `duration`: every recording's length, s (default: the preset's).
+    pub duration: Option<f64>,
+    /// `readout`: dvxplorer, prophesee or dvs128.
+    pub readout: String,
+    /// `compression`: AEDAT4 packet compression.
+    pub compression: eenf_events::Compression,
+    /// `seed`: the random seed of the whole dataset.
+    pub seed: u64,
+    /// Videos rendered beside each recording.
+    pub video: VideoRenderSettings,
+}
+
+impl Default for DatasetSettings {
+    fn default() -> Self {
+        DatasetSettings {
+            preset: "ev-enfd".into(),
+            enf_dir: None,
+            grid: 50,
+            start: "2022-08-17T16".into(),
+            tz: "+08:00".into(),
+            resolution: None,
+            duration: None,
+            readout: "dvxplorer".into(),
+            compression: eenf_events::Compression::Lz4,
+            seed: 2023,
+            video: VideoRenderSettings::default(),
+        }
+    }
+}
+
+impl OptionSet for DatasetSettings {
+    fn set(&mut self, name: &str, v: &Value) -> Result<bool, OptionError> {
+        match name {
+            "preset" => self.preset = text("preset", v)?,
+            "enf_dir" => self.enf_dir = maybe("enf_dir", v, text)?.map(PathBuf::from),
+            "grid" => self.grid = whole("grid", v)?,
+            "start" => self.start = text("start", v)?,
+            "tz" => self.tz = text("tz", v)?,
+            "resolution" => self.resolution = maybe("resolution", v, text)?,
+            "duration" => self.duration = maybe("duration", v, number)?,
+            "readout" => self.readout = text("readout", v)?,
+            "compression" => self.compression = super::named("compression", v)?,
+            "seed" => self.seed = whole("seed", v)?,
+            _ => return self.video.set(name, v),
+        }
+        Ok(true)
+    }
+
+    fn check(&self) -> Result<(), OptionError> {
+        counted("grid", self.grid, limits::GRID_HZ)?;
+        if let Some(d) = self.duration {
+            within("duration", d, limits::DURATION_S)?;
+        }
+        self.video.check()
+    }
+}
+
+impl DatasetSettings {
+    /// The build of a dataset into `out_dir`.
+    pub fn build(&self, out_dir: PathBuf) -> anyhow::Result<crate::dataset::DatasetBuild> {
+        use crate::dataset::{parse_local_hour, DatasetBuild, DatasetEnf, DatasetSpec};
+        self.check()?;
+        Ok(DatasetBuild {
+            out_dir,
+            spec: DatasetSpec {
+                preset: self.preset.clone(),
+                duration_s: self.duration,
+                resolution: self
+                    .resolution
+                    .as_deref()
+                    .map(parse_resolution)
+                    .transpose()?,
+                readout: parse_readout(&self.readout)?,
+                tz_s: crate::time::tz_offset(&self.tz)?,
+                seed: self.seed,
+            },
+            enf: match &self.enf_dir {
+                Some(dir) => DatasetEnf::WavDir(dir.clone()),
+                None => DatasetEnf::Synthetic {
+                    grid_hz: self.grid as f64,
+                    from_local_s: parse_local_hour(&self.start)?,
+                },
+            },
+            compression: self.compression,
+            cameras: self.video.cameras()?,
+            mp4: self.video.mp4,
+        })
+    }
+}
