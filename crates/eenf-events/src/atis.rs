@@ -114,3 +114,17 @@ pub fn reader(src: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventReader>>
         info,
     )?))
 }
+
+/// The headerless ATIS `.bin` for probing ([`crate::registry`]), last: whole 5-byte words
+/// whose times never go back.
+pub const REGISTERED: crate::Registered = crate::Registered {
+    name: "ATIS .bin",
+    probe: |head, src, path| {
+        let len = src
+            .seek(std::io::SeekFrom::End(0))
+            .map_err(|e| crate::error::io_err(path, e))?;
+        let found = looks_like(head.bytes, len);
+        Ok(found.then(|| crate::Probed::of(crate::Format::AtisBin)))
+    },
+    open: |src, path, _, _| reader(src, path),
+};

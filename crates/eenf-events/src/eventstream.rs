@@ -139,3 +139,16 @@ pub fn reader(mut src: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventRead
         info,
     )?))
 }
+
+/// Event Stream for probing ([`crate::registry`]): its magic.
+pub const REGISTERED: crate::Registered = crate::Registered {
+    name: "Event Stream",
+    probe: |head, _, _| {
+        Ok(crate::registry::by_magic(
+            head,
+            MAGIC,
+            crate::Format::EventStream,
+        ))
+    },
+    open: |src, path, _, _| reader(src, path),
+};

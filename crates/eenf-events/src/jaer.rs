@@ -450,3 +450,29 @@ impl EventReader for Aedat31Reader {
         .collect()
     }
 }
+
+/// jAER AEDAT 2.0 for probing ([`crate::registry`]): its `#!AER-DAT2.0` line.
+pub const AEDAT2: crate::Registered = crate::Registered {
+    name: "AEDAT 2.0",
+    probe: |head, _, _| {
+        Ok(crate::registry::by_magic(
+            head,
+            b"#!AER-DAT2.0",
+            crate::Format::Aedat2,
+        ))
+    },
+    open: |src, path, opts, _| aedat2_with(src, path, opts),
+};
+
+/// jAER AEDAT 3.1 for probing ([`crate::registry`]): its `#!AER-DAT3` line.
+pub const AEDAT31: crate::Registered = crate::Registered {
+    name: "AEDAT 3.1",
+    probe: |head, _, _| {
+        Ok(crate::registry::by_magic(
+            head,
+            b"#!AER-DAT3",
+            crate::Format::Aedat31,
+        ))
+    },
+    open: |src, path, _, _| aedat31_from(src, path),
+};

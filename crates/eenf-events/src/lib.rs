@@ -33,6 +33,7 @@ pub mod jaer;
 pub mod memory;
 mod prefetch;
 pub mod prophesee;
+pub mod registry;
 pub mod rosbag;
 pub mod rosbag2;
 pub mod rosmsg;
@@ -50,6 +51,7 @@ pub use eenf_core::EventBatch;
 pub use error::{EventError, Result};
 pub use guard::{Damage, DamageKind, DEFAULT_MAX_GAP_US};
 pub use memory::open_events;
+pub use registry::{Probed, Registered, FORMATS};
 pub use text::TextReader;
 
 /// The formats this version reads, for error messages.
@@ -181,14 +183,6 @@ impl<T: std::io::Write + Seek + Send> Sink for T {}
 /// Bytes looked at to decide a format.
 const HEAD: usize = 4096;
 
-/// What [`probe_source`] found: the format, and the Prophesee `% ` header when it read one
-/// (handed on so that it is read once).
-pub struct Probed {
-    /// The format.
-    pub format: Format,
-    header: Option<stream::TextHeader>,
-}
-
 /// Decides the format of the file at `path` from its first bytes (`-`: stdin); a folder is a
 /// rosbag2 when it holds its storage files.
 pub fn probe(path: &Path) -> Result<Format> {
@@ -264,6 +258,12 @@ fn folder_format(dir: &Path) -> Result<Format> {
 /// Decides the format of `src` (named `path` in errors) from its first bytes; leaves `src`
 /// at its start.
 pub fn probe_source(src: &mut dyn Source, path: &Path) -> Result<Probed> {
+    probe_registered(src, path).map(|(probed, _)| probed)
+}
+
+/// The first registered format ([`FORMATS`]) whose probe recognises the head of `src`, and
+/// its reader's opener; leaves `src` at its start.
+fn probe_registered(src: &mut dyn Source, path: &Path) -> Result<(Probed, registry::OpenFn)> {
     let mut head = vec![0u8; HEAD];
     let mut n = 0;
     while n < head.len() {
@@ -277,12 +277,6 @@ pub fn probe_source(src: &mut dyn Source, path: &Path) -> Result<Probed> {
     head.truncate(n);
     src.seek(SeekFrom::Start(0))
         .map_err(|e| error::io_err(path, e))?;
-    let found = |format| {
-        Ok(Probed {
-            format,
-            header: None,
-        })
-    };
     let unknown = |reason: String| EventError::UnknownFormat {
         path: path.to_path_buf(),
         reason,
@@ -291,85 +285,21 @@ pub fn probe_source(src: &mut dyn Source, path: &Path) -> Result<Probed> {
     if n == 0 {
         return Err(unknown("the file is empty".into()));
     }
-    if head.starts_with(aedat4::MAGIC) {
-        return found(Format::Aedat4);
-    }
-    if head.starts_with(b"#!AER-DAT2.0") {
-        return found(Format::Aedat2);
-    }
-    if head.starts_with(b"#!AER-DAT3") {
-        return found(Format::Aedat31);
-    }
-    if head.starts_with(eventstream::MAGIC) {
-        return found(Format::EventStream);
-    }
-    if head.starts_with(rosbag::MAGIC) {
-        return found(Format::RosBag);
-    }
-    if head.starts_with(rosbag2::SQLITE_MAGIC) || head.starts_with(rosbag2::MCAP_MAGIC) {
-        return found(Format::Rosbag2);
-    }
-    if head.starts_with(hdf5::MAGIC) {
-        return found(Format::Hdf5);
-    }
-    if head.starts_with(b"%") {
-        let header = prophesee::read_header(src, path)?;
+    let head = registry::Head {
+        bytes: &head,
+        cut: n == HEAD,
+    };
+    for format in FORMATS {
+        let found = (format.probe)(&head, src, path)?;
         src.seek(SeekFrom::Start(0))
             .map_err(|e| error::io_err(path, e))?;
-        let format = match prophesee::format_from_header(&header.lines) {
-            Some(kind) => kind,
-            // a DAT header may name nothing; its data starts with type 0 and size 8
-            None if head.get(header.data_start as usize..header.data_start as usize + 2)
-                == Some(&[0, 8]) =>
-            {
-                prophesee::ProphFormat::Dat
-            }
-            None => {
-                return Err(unknown(
-                    "a % header that names no EVT encoding or DAT version".into(),
-                ))
-            }
-        };
-        return Ok(Probed {
-            format: Format::Prophesee(format),
-            header: Some(header),
-        });
-    }
-    // Text: the first event line (after comments) holds four numbers. Judge only complete lines.
-    let text = String::from_utf8_lossy(&head);
-    let complete = match text.rfind('\n') {
-        Some(i) if n == HEAD => &text[..i],
-        _ => &text[..],
-    };
-    if !head.contains(&0) {
-        let mut names_seen = false;
-        for line in complete.lines() {
-            let l = line.trim();
-            if l.is_empty() || l.starts_with('#') {
-                continue;
-            }
-            if !names_seen && text::is_column_names(l) {
-                names_seen = true;
-                continue;
-            }
-            if text::looks_like_event_line(l) {
-                return found(Format::Text);
-            }
-            break;
+        if let Some(found) = found {
+            return Ok((found, format.open));
         }
-    }
-    // headerless ATIS words: whole 5-byte words whose times never go back
-    let len = src
-        .seek(SeekFrom::End(0))
-        .map_err(|e| error::io_err(path, e))?;
-    src.seek(SeekFrom::Start(0))
-        .map_err(|e| error::io_err(path, e))?;
-    if atis::looks_like(&head, len) {
-        return found(Format::AtisBin);
     }
     Err(unknown(format!(
         "unrecognised content starting with {:?}",
-        String::from_utf8_lossy(&head[..n.min(16)])
+        String::from_utf8_lossy(&head.bytes[..n.min(16)])
     )))
 }
 
@@ -402,27 +332,11 @@ pub fn open_source_with(
     path: &Path,
     opts: &OpenOptions,
 ) -> Result<Box<dyn EventReader>> {
-    let probed = probe_source(src.as_mut(), path)?;
-    check_options(probed.format, path, opts)?;
-    let reader: Box<dyn EventReader> = match probed.format {
-        Format::Aedat4 => Box::new(Aedat4Reader::new(src, path)?),
-        Format::Prophesee(kind) => {
-            let header = match probed.header {
-                Some(header) => header,
-                None => prophesee::read_header(src.as_mut(), path)?,
-            };
-            prophesee::from_header(src, path, header, kind)?
-        }
-        Format::Aedat2 => jaer::aedat2_with(src, path, opts)?,
-        Format::Aedat31 => jaer::aedat31_from(src, path)?,
-        Format::Text => Box::new(TextReader::new(src, path)?),
-        Format::EventStream => eventstream::reader(src, path)?,
-        Format::AtisBin => atis::reader(src, path)?,
-        Format::RosBag => rosbag::reader(src, path, opts.topic.as_deref())?,
-        Format::Rosbag2 => rosbag2::reader(src, path, opts.topic.as_deref())?,
-        Format::Hdf5 => hdf5::reader(src, path, opts.camera)?,
-    };
-    finish(reader, probed.format, path, opts)
+    let (probed, open) = probe_registered(src.as_mut(), path)?;
+    let format = probed.format;
+    check_options(format, path, opts)?;
+    let reader = open(src, path, opts, probed)?;
+    finish(reader, format, path, opts)
 }
 
 /// Refuses options that the format cannot take.

@@ -424,3 +424,59 @@ impl Skips {
         }
     }
 }
+
+/// Prophesee RAW and DAT for probing ([`crate::registry`]): a `%` header that names the
+/// encoding (or a DAT whose data starts with type 0 and size 8). The header is read once and
+/// handed to the reader.
+pub const REGISTERED: crate::Registered = crate::Registered {
+    name: "Prophesee RAW/DAT",
+    probe: probe_registered,
+    open: open_registered,
+};
+
+fn probe_registered(
+    head: &crate::registry::Head,
+    src: &mut dyn Source,
+    path: &Path,
+) -> Result<Option<crate::Probed>> {
+    if !head.starts_with(b"%") {
+        return Ok(None);
+    }
+    let header = read_header(src, path)?;
+    let start = header.data_start as usize;
+    let format = match format_from_header(&header.lines) {
+        Some(kind) => kind,
+        // a DAT header may name nothing; its data starts with type 0 and size 8
+        None if head.bytes.get(start..start + 2) == Some(&[0, 8]) => ProphFormat::Dat,
+        None => {
+            return Err(EventError::UnknownFormat {
+                path: path.to_path_buf(),
+                reason: "a % header that names no EVT encoding or DAT version".into(),
+                supported: crate::SUPPORTED,
+            })
+        }
+    };
+    Ok(Some(crate::Probed {
+        format: crate::Format::Prophesee(format),
+        header: Some(header),
+    }))
+}
+
+fn open_registered(
+    mut src: Box<dyn Source>,
+    path: &Path,
+    _: &crate::OpenOptions,
+    probed: crate::Probed,
+) -> Result<Box<dyn crate::EventReader>> {
+    let crate::Format::Prophesee(kind) = probed.format else {
+        return Err(EventError::Unfit {
+            path: path.to_path_buf(),
+            reason: "not a Prophesee file".into(),
+        });
+    };
+    let header = match probed.header {
+        Some(header) => header,
+        None => read_header(src.as_mut(), path)?,
+    };
+    from_header(src, path, header, kind)
+}

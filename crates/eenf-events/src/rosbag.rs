@@ -455,3 +455,16 @@ impl BagReader {
         Ok((!batch.is_empty()).then_some(batch))
     }
 }
+
+/// ROS 1 bags for probing ([`crate::registry`]): the `#ROSBAG V2.0` line.
+pub const REGISTERED: crate::Registered = crate::Registered {
+    name: "ROS 1 bag",
+    probe: |head, _, _| {
+        Ok(crate::registry::by_magic(
+            head,
+            MAGIC,
+            crate::Format::RosBag,
+        ))
+    },
+    open: |src, path, opts, _| reader(src, path, opts.topic.as_deref()),
+};

@@ -265,3 +265,39 @@ impl EventReader for TextReader {
         Ok(if batch.is_empty() { None } else { Some(batch) })
     }
 }
+
+/// Text for probing ([`crate::registry`]): no NUL byte, and the first event line (after
+/// comments and a line of column names) holds four numbers. Only complete lines are judged.
+pub const REGISTERED: crate::Registered = crate::Registered {
+    name: "text",
+    probe: |head, _, _| {
+        let found = looks_like_text(head.bytes, head.cut);
+        Ok(found.then(|| crate::Probed::of(crate::Format::Text)))
+    },
+    open: |src, path, _, _| Ok(Box::new(TextReader::new(src, path)?)),
+};
+
+/// Whether `head` reads as text events (`cut`: the stream goes on past it).
+fn looks_like_text(head: &[u8], cut: bool) -> bool {
+    if head.contains(&0) {
+        return false;
+    }
+    let text = String::from_utf8_lossy(head);
+    let complete = match text.rfind('\n') {
+        Some(i) if cut => &text[..i],
+        _ => &text[..],
+    };
+    let mut names_seen = false;
+    for line in complete.lines() {
+        let l = line.trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        if !names_seen && is_column_names(l) {
+            names_seen = true;
+            continue;
+        }
+        return looks_like_event_line(l);
+    }
+    false
+}

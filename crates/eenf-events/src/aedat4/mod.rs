@@ -699,3 +699,25 @@ impl EventReader for Aedat4Reader {
         }
     }
 }
+
+/// AEDAT 4.0 for probing ([`crate::registry`]): its magic line.
+pub const REGISTERED: crate::Registered = crate::Registered {
+    name: "AEDAT 4.0",
+    probe: |head, _, _| {
+        Ok(crate::registry::by_magic(
+            head,
+            MAGIC,
+            crate::Format::Aedat4,
+        ))
+    },
+    open: open_registered,
+};
+
+fn open_registered(
+    src: Box<dyn Source>,
+    path: &Path,
+    _: &crate::OpenOptions,
+    _: crate::Probed,
+) -> Result<Box<dyn crate::EventReader>> {
+    Ok(Box::new(Aedat4Reader::new(src, path)?))
+}
