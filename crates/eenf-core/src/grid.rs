@@ -9,6 +9,16 @@ pub enum Nominal {
     Hz(f64),
 }
 
+impl Nominal {
+    /// The grid frequency when it is given, Hz; `None` when it is to be detected.
+    pub fn hz(self) -> Option<f64> {
+        match self {
+            Nominal::Hz(f) => Some(f),
+            Nominal::Auto => None,
+        }
+    }
+}
+
 impl std::str::FromStr for Nominal {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, String> {

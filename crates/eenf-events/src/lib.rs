@@ -51,7 +51,7 @@ pub use eenf_core::EventBatch;
 pub use error::{EventError, Result};
 pub use guard::{Damage, DamageKind, DEFAULT_MAX_GAP_US};
 pub use memory::open_events;
-pub use registry::{Probed, Registered, FORMATS};
+pub use registry::{Probed, Registered};
 pub use text::TextReader;
 
 /// The formats this version reads, for error messages.
@@ -171,6 +171,21 @@ pub enum Format {
     /// HDF5 (DSEC, M3ED, MVSEC, TUM-VIE, Prophesee's own).
     Hdf5,
 }
+
+/// Every format read from a byte stream, in probing order (a rosbag2 folder is told by its
+/// files, before any probe).
+pub const FORMATS: &[Registered] = &[
+    aedat4::REGISTERED,
+    jaer::AEDAT2,
+    jaer::AEDAT31,
+    eventstream::REGISTERED,
+    rosbag::REGISTERED,
+    rosbag2::REGISTERED,
+    hdf5::REGISTERED,
+    prophesee::REGISTERED,
+    text::REGISTERED,
+    atis::REGISTERED,
+];
 
 /// A byte stream a reader can read: a file, a `Cursor<Vec<u8>>`, stdin read into memory.
 pub trait Source: Read + Seek + Send {}

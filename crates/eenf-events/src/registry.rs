@@ -1,8 +1,8 @@
 //! The formats eenf reads, each registered once by its own module (as Symphonia's readers
 //! register their probes): how its first bytes are recognised, and how its reader is opened.
-//! [`crate::probe_source`] tries them in the order of [`FORMATS`]: the formats with a
-//! signature first, then text, then the headerless ATIS words (content that random bytes
-//! rarely have), so that a new format goes in by adding its module's entry here.
+//! [`crate::probe_source`] tries them in the order of `FORMATS` (in `lib.rs`): the formats
+//! with a signature first, then text, then the headerless ATIS words (content that random
+//! bytes rarely have), so that a new format goes in by adding its module's entry there.
 
 use std::path::Path;
 
@@ -62,18 +62,3 @@ pub struct Registered {
 pub fn by_magic(head: &Head, magic: &[u8], format: Format) -> Option<Probed> {
     head.starts_with(magic).then(|| Probed::of(format))
 }
-
-/// Every format read from a byte stream, in probing order (a rosbag2 folder is told by its
-/// files, before any probe).
-pub const FORMATS: &[Registered] = &[
-    crate::aedat4::REGISTERED,
-    crate::jaer::AEDAT2,
-    crate::jaer::AEDAT31,
-    crate::eventstream::REGISTERED,
-    crate::rosbag::REGISTERED,
-    crate::rosbag2::REGISTERED,
-    crate::hdf5::REGISTERED,
-    crate::prophesee::REGISTERED,
-    crate::text::REGISTERED,
-    crate::atis::REGISTERED,
-];

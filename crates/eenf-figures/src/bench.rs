@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use eenf::bench::report::stem;
-use eenf::bench::{paper_value, Method, Outcome, Recording, Run};
+use eenf::bench::{paper_value, DatasetEntry, Method, Outcome, Run};
 use eenf::progress::Progress;
 
 use crate::{plot_extraction, plot_methods, plot_spectrogram, plot_summary, Series, SummaryBar};
@@ -14,7 +14,7 @@ use crate::{plot_extraction, plot_methods, plot_spectrogram, plot_summary, Serie
 /// Writes each figure as PNG and SVG; returns how many files.
 pub fn write_plots(
     dir: &Path,
-    recs: &[Recording],
+    recs: &[DatasetEntry],
     runs: &[Run],
     methods: &[Method],
     progress: &Progress,

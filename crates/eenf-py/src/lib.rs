@@ -382,7 +382,7 @@ fn extract_events(
 /// The ENF of a sound file (`eenf reference`). The GIL is released.
 #[pyfunction]
 #[pyo3(signature = (path, options="{}"))]
-fn reference(py: Python<'_>, path: PathBuf, options: &str) -> PyResult<PyTrace> {
+fn trace_sound(py: Python<'_>, path: PathBuf, options: &str) -> PyResult<PyTrace> {
     let (audio, tracker) = sound_settings(options)?;
     let params = tracker.params().map_err(option_err)?;
     traced(py.detach(|| {
@@ -399,7 +399,7 @@ fn reference(py: Python<'_>, path: PathBuf, options: &str) -> PyResult<PyTrace> 
 /// The ENF of samples in memory: `interleaved` frames of `channels` channels at `fs` Hz.
 #[pyfunction]
 #[pyo3(signature = (interleaved, channels, fs, name, options="{}"))]
-fn reference_samples(
+fn trace_samples(
     py: Python<'_>,
     interleaved: PyReadonlyArray1<'_, f32>,
     channels: usize,
@@ -520,7 +520,7 @@ fn compare(
 /// The GIL is released.
 #[pyfunction]
 #[pyo3(signature = (trace, name, reference, options="{}"))]
-fn match_trace(
+fn locate(
     py: Python<'_>,
     trace: PyRef<'_, PyTrace>,
     name: PathBuf,
@@ -602,8 +602,9 @@ fn simulate_dataset(py: Python<'_>, out_dir: PathBuf, options: &str) -> PyResult
     py.detach(|| {
         let build = a.build(out_dir.clone())?;
         let mut notes = Vec::new();
-        let built =
-            eenf::dataset::build_dataset(&build, &Progress::hidden(), &mut |n| notes.push(n))?;
+        let built = eenf::dataset_build::build_dataset(&build, &Progress::hidden(), &mut |n| {
+            notes.push(n)
+        })?;
         Ok(serde_json::json!({
             "out_dir": out_dir,
             "manifest": out_dir.join("manifest.csv"),
@@ -728,12 +729,12 @@ fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(extract, m)?)?;
     m.add_function(wrap_pyfunction!(extract_events, m)?)?;
-    m.add_function(wrap_pyfunction!(reference, m)?)?;
-    m.add_function(wrap_pyfunction!(reference_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(trace_sound, m)?)?;
+    m.add_function(wrap_pyfunction!(trace_samples, m)?)?;
     m.add_function(wrap_pyfunction!(video, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(plot_trace, m)?)?;
-    m.add_function(wrap_pyfunction!(match_trace, m)?)?;
+    m.add_function(wrap_pyfunction!(locate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(refdb_build, m)?)?;

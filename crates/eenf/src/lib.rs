@@ -12,8 +12,9 @@
 //!   series [`locate`] searches (`match`), and the store [`refdb`] keeps them in.
 //! - [`evaluate`]: a `Trace` against its reference → an `Agreement` (CC, MAE, RMSE, max).
 //! - [`edits`]: was a recording edited? Cuts and insertions from the hum's phase.
-//! - [`bench`]: every method over a dataset, Table 2 and its reports; [`simulation`] and
-//!   [`dataset`]: simulated recordings and datasets with their truth.
+//! - [`bench`]: every method over a dataset, Table 2 and its reports; [`simulation`],
+//!   [`dataset`] and [`dataset_build`]: simulated recordings and datasets with their truth.
+//! - [`options`]: what each front end asks for, as option sets that check themselves.
 //!
 //! [`recording`] is what E-ENF reads (a file or events in memory); [`trace`] reads and writes
 //! traces, [`output`] writes every file whole or not at all, [`time`] holds all calendar and
@@ -25,6 +26,7 @@ pub mod archive;
 pub mod audio;
 pub mod bench;
 pub mod dataset;
+pub mod dataset_build;
 pub mod edits;
 pub mod evaluate;
 pub mod extract;

@@ -84,13 +84,13 @@ pub fn locate(
 ) -> Result<Located> {
     let nominal_hz = match_grid(trace, name)?;
     let references = ReferenceSeries::load(reference, nominal_hz, zone, progress)?;
-    let report = match_trace_in(trace, name, nominal_hz, &references, query)?;
+    let report = locate_in(trace, name, nominal_hz, &references, query)?;
     Ok(Located { report, references })
 }
 
 /// Where `trace` (named `name`, on the `nominal_hz` grid [`match_grid`] found) fits in the
 /// series `refs`, as `query` asks.
-pub fn match_trace_in(
+pub fn locate_in(
     trace: &Trace,
     name: &Path,
     nominal_hz: f64,

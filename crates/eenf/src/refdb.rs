@@ -50,9 +50,10 @@ pub struct RefMeta {
     pub values_crc32: Option<u32>,
 }
 
-/// One grid's series in memory.
+/// One grid of a store, read into memory: its metadata and values (what `match` loads its
+/// reference series from).
 #[derive(Debug, Clone)]
-pub struct RefSeries {
+pub struct StoredGrid {
     /// Metadata.
     pub meta: RefMeta,
     /// Values (µHz from nominal, `GAP` for none).
@@ -140,10 +141,10 @@ fn crc_of(bytes: &[u8]) -> u32 {
     h.finalize()
 }
 
-impl RefSeries {
+impl StoredGrid {
     /// An empty series.
     pub fn new(grid: &str, nominal_hz: f64, step_s: f64, start_unix_s: f64) -> Self {
-        RefSeries {
+        StoredGrid {
             meta: RefMeta {
                 grid: grid.to_string(),
                 nominal_hz,
@@ -260,7 +261,7 @@ impl RefSeries {
             .chunks_exact(4)
             .map(|c| i32::from_le_bytes(c.try_into().unwrap()))
             .collect();
-        Ok(RefSeries { meta, values })
+        Ok(StoredGrid { meta, values })
     }
 
     /// Commits the series: a new values file, then the manifest that names it renamed over

@@ -14,7 +14,7 @@ use crate::audio::read_wav;
 use crate::dataset::hourly_references;
 use crate::mains::{mains_nominal, reference_file};
 use crate::progress::Progress;
-use crate::refdb::{check_grid_name, RefSeries, StoreLock, GAP};
+use crate::refdb::{check_grid_name, StoreLock, StoredGrid, GAP};
 use crate::time::{LocalInstant, LocalTime, Zone};
 use crate::trace::Trace;
 use crate::wav::is_wav;
@@ -44,7 +44,7 @@ impl ReferenceSource {
     pub fn open(path: &Path) -> Result<Self> {
         let p = path.to_path_buf();
         Ok(if path.is_dir() {
-            if RefSeries::grids(path)?.is_empty() {
+            if StoredGrid::grids(path)?.is_empty() {
                 ReferenceSource::HourlyFolder(p)
             } else {
                 ReferenceSource::Store(p)
@@ -291,16 +291,16 @@ impl ReferenceSeries {
             source,
             ReferenceSource::Store(_) | ReferenceSource::HourlyFolder(_)
         ) {
-            let grids = RefSeries::grids(path)?;
+            let grids = StoredGrid::grids(path)?;
             if let ReferenceSource::Store(_) = source {
                 let _lock = StoreLock::shared(path)?;
                 let mut out = Vec::new();
                 for g in grids {
-                    let meta = RefSeries::load_meta(path, &g)?;
+                    let meta = StoredGrid::load_meta(path, &g)?;
                     if meta.nominal_hz != nominal {
                         continue; // 50 and 60 Hz are never mixed
                     }
-                    let s = RefSeries::load(path, &g)?;
+                    let s = StoredGrid::load(path, &g)?;
                     out.push(ReferenceSeries {
                         name: g,
                         start: meta.start_unix_s,
@@ -322,7 +322,7 @@ impl ReferenceSeries {
             // a folder of hourly WAVs, assembled in memory
             let files = hourly_references(path)?;
             let bar = progress.steps(files.len() as u64, "tracking the references");
-            let mut series = RefSeries::new("folder", nominal, 1.0, 0.0);
+            let mut series = StoredGrid::new("folder", nominal, 1.0, 0.0);
             for (_, f) in &files {
                 let trace = reference_file(f, Nominal::Auto, &EnfParams::default())?;
                 if trace.nominal_hz == Some(nominal) {
@@ -475,7 +475,7 @@ pub fn build_store(
     // the whole read-merge-write under the store's lock: a second build waits for this one
     let _lock = StoreLock::exclusive(store, build.wait, on_wait)?;
     let bar = progress.steps(files.len() as u64, "adding references");
-    let mut series: Vec<RefSeries> = Vec::new();
+    let mut series: Vec<StoredGrid> = Vec::new();
     let mut next_start = build.start;
     let mut archives = Vec::new();
     for (path, at, archive) in &files {
@@ -528,9 +528,9 @@ pub fn build_store(
             Some(i) => i,
             None => {
                 let s = if store.join(format!("{grid}.json")).exists() {
-                    RefSeries::load(store, &grid)?
+                    StoredGrid::load(store, &grid)?
                 } else {
-                    RefSeries::new(&grid, f0, step, start)
+                    StoredGrid::new(&grid, f0, step, start)
                 };
                 series.push(s);
                 series.len() - 1
@@ -553,7 +553,7 @@ pub fn build_store(
     let mut built = Vec::new();
     for s in &mut series {
         s.save(store)?;
-        RefSeries::remove_orphans(store, &s.meta.grid)?;
+        StoredGrid::remove_orphans(store, &s.meta.grid)?;
         built.push(GridBuilt {
             grid: s.meta.grid.clone(),
             values: s.values.len(),

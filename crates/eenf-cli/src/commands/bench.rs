@@ -10,7 +10,6 @@ use eenf::bench::run::{jobs_for, run_all};
 use eenf::bench::{discover, group_by_prominence, sweep, Method, Settings};
 use eenf::output::write_atomic;
 use eenf::progress::Progress;
-use eenf_core::Nominal;
 use eenf_video::{IdleRows, RowSampling, SceneRemoval, VideoOptions};
 
 use crate::args::{one_of, MethodArgs};
@@ -90,10 +89,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     }
     let extract = a.method.options()?;
     let video = VideoOptions {
-        nominal_hz: match a.method.tracker.nominal {
-            Nominal::Hz(f) => Some(f),
-            Nominal::Auto => None,
-        },
+        nominal_hz: a.method.tracker.nominal.hz(),
         sampling: RowSampling::ZeroPad(IdleRows::Auto),
         scene_removal: a.scene_removal,
         params: eenf_dsp::EnfParams {

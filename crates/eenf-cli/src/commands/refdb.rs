@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 use eenf::progress::Progress;
-use eenf::refdb::{RefSeries, StoreLock, GAP};
+use eenf::refdb::{StoreLock, StoredGrid, GAP};
 use eenf::reference::build_store;
 use eenf::time::{utc, Zone};
 
@@ -71,13 +71,13 @@ fn build(a: BuildArgs, progress: Progress) -> Result<()> {
 }
 
 fn info(store: &Path, zone: Option<&Zone>) -> Result<()> {
-    let grids = RefSeries::grids(store)?;
+    let grids = StoredGrid::grids(store)?;
     if grids.is_empty() {
         bail!("{}: no reference series here", store.display());
     }
     let _lock = StoreLock::shared(store)?;
     for g in grids {
-        let s = RefSeries::load(store, &g)?;
+        let s = StoredGrid::load(store, &g)?;
         let m = &s.meta;
         let gaps = s.values.iter().filter(|&&v| v == GAP).count();
         let runs = s

@@ -8,7 +8,7 @@ use std::path::Path;
 use crate::cli;
 use cli::eenf;
 
-use eenf::refdb::RefSeries;
+use eenf::refdb::StoredGrid;
 use eenf::time::{parse_time, Zone};
 
 /// Runs `eenf ARGS`, which must succeed: its stdout and stderr.
@@ -82,7 +82,7 @@ fn an_archive_across_both_summer_time_changes_loses_and_doubles_no_hour() {
             && said.contains("3600 rows in the second"),
         "{said}"
     );
-    let s = RefSeries::load(&d.join("store"), "DE").unwrap();
+    let s = StoredGrid::load(&d.join("store"), "DE").unwrap();
     let hz = s.hz();
     assert_eq!(s.meta.start_unix_s, t(spring.0));
     // every UTC second of both stretches holds its own value, and nothing else is filled
@@ -186,7 +186,7 @@ fn zip_7z_and_gzip_archives_give_the_same_seconds() {
                 "{said}"
             );
         }
-        stores.push(RefSeries::load(&d.join(&store), "grid50").unwrap());
+        stores.push(StoredGrid::load(&d.join(&store), "grid50").unwrap());
     }
     let s = &stores[0];
     assert_eq!(s.meta.start_unix_s, t("2023-06-01T21:55:00Z"));
@@ -213,7 +213,7 @@ fn zip_7z_and_gzip_archives_give_the_same_seconds() {
         said.contains("warning") && said.contains("damaged zip"),
         "{said}"
     );
-    let cut = RefSeries::load(&d.join("cut"), "grid50").unwrap();
+    let cut = StoredGrid::load(&d.join("cut"), "grid50").unwrap();
     assert!(cut.values.len() >= 300, "{}", cut.values.len());
     assert_eq!(cut.values[..300], s.values[..300]);
     // a 7z keeps its directory at the end: cut short, it is refused in one line

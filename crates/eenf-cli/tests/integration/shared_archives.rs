@@ -31,7 +31,7 @@ fn rows(name: &str) -> Vec<(String, f64)> {
 
 /// The store's values (Hz, NaN for gaps) and its first time, read back through the library.
 fn stored(store: &Path, grid: &str) -> (f64, Vec<f64>) {
-    let s = eenf::refdb::RefSeries::load(store, grid).unwrap();
+    let s = eenf::refdb::StoredGrid::load(store, grid).unwrap();
     (s.meta.start_unix_s, s.hz())
 }
 

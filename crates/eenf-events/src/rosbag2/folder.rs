@@ -156,3 +156,17 @@ fn listed_files(yaml: &str) -> Vec<String> {
     }
     out
 }
+
+/// A reader of the rosbag2 folder `dir`: its topic `topic`, or its first topic of event
+/// messages.
+pub fn folder(dir: &Path, topic: Option<&str>) -> Result<Box<dyn crate::EventReader>> {
+    let files = storage_files(dir)?;
+    if files.is_empty() {
+        return Err(EventError::UnknownFormat {
+            path: dir.to_path_buf(),
+            reason: "a folder without rosbag2 storage files (.db3, .mcap)".into(),
+            supported: crate::SUPPORTED,
+        });
+    }
+    super::start(dir, files, None, topic)
+}

@@ -28,7 +28,7 @@ use crate::spool::NamedCopy;
 
 pub mod folder;
 use crate::{EventBatch, EventReader, Source, StreamDesc, StreamInfo};
-pub use folder::{is_folder, storage_files};
+pub use folder::{folder, is_folder, storage_files};
 
 /// The first bytes of an SQLite database.
 pub const SQLITE_MAGIC: &[u8] = b"SQLite format 3\0";
@@ -135,20 +135,6 @@ pub struct Rosbag2Reader {
     /// The topics of the first file, kept when it ends (an MCAP without a summary names them
     /// only as they come).
     first_topics: Vec<Topic>,
-}
-
-/// A reader of the rosbag2 folder `dir`: its topic `topic`, or its first topic of event
-/// messages.
-pub fn folder(dir: &Path, topic: Option<&str>) -> Result<Box<dyn EventReader>> {
-    let files = storage_files(dir)?;
-    if files.is_empty() {
-        return Err(EventError::UnknownFormat {
-            path: dir.to_path_buf(),
-            reason: "a folder without rosbag2 storage files (.db3, .mcap)".into(),
-            supported: crate::SUPPORTED,
-        });
-    }
-    start(dir, files, None, topic)
 }
 
 /// A reader of the rosbag2 storage file in `src` (named `path`).

@@ -426,12 +426,12 @@ def reference(
     if _is_path(source):
         if fs is not None:
             raise ValueError("fs is for samples in memory; a file gives its own rate")
-        return _trace(_eenf.reference(os.fspath(source), _options(params)))
+        return _trace(_eenf.trace_sound(os.fspath(source), _options(params)))
     if fs is None:
         raise TypeError("reference: samples in memory need their rate: fs=...")
     frames = _frames(source, "reference")
     return _trace(
-        _eenf.reference_samples(frames.reshape(-1), frames.shape[1], float(fs), name, _options(params))
+        _eenf.trace_samples(frames.reshape(-1), frames.shape[1], float(fs), name, _options(params))
     )
 
 
@@ -530,7 +530,7 @@ def match(trace: Any, reference: PathLike, top: int = 5, **params: Any) -> Dict[
     MAE, p-value), and with ``verify=TIME`` how the claimed time fits."""
     native, name = _as_trace(trace)
     return json.loads(
-        _eenf.match_trace(native, name, os.fspath(reference), _options({"top": top, **params}))
+        _eenf.locate(native, name, os.fspath(reference), _options({"top": top, **params}))
     )
 
 

@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 
-/// One recording of a dataset.
+/// One recording of a dataset to score: its event file, class, reference and videos.
 #[derive(Debug, Clone, Serialize)]
-pub struct Recording {
+pub struct DatasetEntry {
     /// The event file.
     pub path: PathBuf,
     /// Its class (`static`, `dynamic`, `extreme`, or any folder name).
@@ -35,7 +35,7 @@ pub const PROMINENCE_BANDS: [(f64, &str); 4] = [
 
 /// Regroups recordings by the prominence of their flicker line (from the manifest) instead
 /// of their class. Fails when a recording has none.
-pub fn group_by_prominence(recs: &mut [Recording]) -> Result<()> {
+pub fn group_by_prominence(recs: &mut [DatasetEntry]) -> Result<()> {
     for r in recs.iter_mut() {
         let Some(p) = r.prominence else {
             bail!(
@@ -54,7 +54,7 @@ pub fn group_by_prominence(recs: &mut [Recording]) -> Result<()> {
     Ok(())
 }
 
-impl Recording {
+impl DatasetEntry {
     /// The recording's name for tables: `class/stem`.
     pub fn name(&self) -> String {
         let stem = self.path.file_stem().unwrap_or_default().to_string_lossy();
@@ -99,7 +99,7 @@ fn has_extension(p: &Path, list: &[&str]) -> bool {
 /// The recordings of `dataset`: a manifest CSV, or a folder laid out like the EV-ENFD (one
 /// folder per class holding event files and their `<stem>_lr.*`/`<stem>_hr.*` videos, and
 /// `ENF_Reference/` with hourly WAVs).
-pub fn discover(dataset: &Path) -> Result<Vec<Recording>> {
+pub fn discover(dataset: &Path) -> Result<Vec<DatasetEntry>> {
     crate::dataset::check_complete(dataset)?;
     if dataset.is_dir() {
         scan_tree(dataset)
@@ -131,7 +131,7 @@ fn is_hidden(p: &Path) -> bool {
         .is_some_and(|n| n.to_string_lossy().starts_with('.'))
 }
 
-fn scan_tree(dir: &Path) -> Result<Vec<Recording>> {
+fn scan_tree(dir: &Path) -> Result<Vec<DatasetEntry>> {
     let references = dir.join("ENF_Reference");
     if !references.is_dir() {
         bail!(
@@ -171,7 +171,7 @@ fn scan_tree(dir: &Path) -> Result<Vec<Recording>> {
                 })
                 .cloned()
                 .collect();
-            out.push(Recording {
+            out.push(DatasetEntry {
                 path: f.clone(),
                 class: class.clone(),
                 reference: references.clone(),
@@ -200,7 +200,7 @@ fn scan_tree(dir: &Path) -> Result<Vec<Recording>> {
 /// Reads a manifest: a CSV with a header holding at least `recording`, `class` and
 /// `reference`, and optionally `offset_s` (seconds into the reference) and `videos`
 /// (`;`-separated). Paths are relative to the manifest's folder.
-pub fn read_manifest(path: &Path) -> Result<Vec<Recording>> {
+pub fn read_manifest(path: &Path) -> Result<Vec<DatasetEntry>> {
     let base = path.parent().unwrap_or(Path::new("."));
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
@@ -251,7 +251,7 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Recording>> {
             .filter(|v| !v.is_empty())
             .map(|v| base.join(v))
             .collect();
-        out.push(Recording {
+        out.push(DatasetEntry {
             path: base.join(&recording),
             class: match get(class_c) {
                 c if c.is_empty() => "unclassified".into(),

@@ -12,7 +12,7 @@ use anyhow::{bail, Result};
 use eenf_core::spelling::option;
 use serde::Serialize;
 
-pub use discover::{class_rank, discover, group_by_prominence, Recording, PROMINENCE_BANDS};
+pub use discover::{class_rank, discover, group_by_prominence, DatasetEntry, PROMINENCE_BANDS};
 pub use run::{evaluate, run_all, summarize, ClassSummary, Outcome, Run};
 pub use settings::{sweep, Settings};
 
@@ -80,7 +80,7 @@ impl Method {
 
     /// The methods whose input some recording of `recs` has (E-ENF always; a video method
     /// when a recording has that camera's video), and those left out.
-    pub fn available(recs: &[Recording]) -> (Vec<Method>, Vec<Method>) {
+    pub fn available(recs: &[DatasetEntry]) -> (Vec<Method>, Vec<Method>) {
         Method::ALL.into_iter().partition(|m| match m.camera() {
             None => true,
             Some(camera) => recs.iter().any(|r| r.video(camera).is_some()),

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use eenf_dsp::Agreement;
 
-use super::{paper_value, Method, Recording, Run};
+use super::{paper_value, DatasetEntry, Method, Run};
 use crate::output::write_atomic;
 
 fn fmt_cc(v: f64) -> String {
@@ -96,7 +96,7 @@ pub fn markdown_table(run: &Run, methods: &[Method]) -> String {
 
 /// The Markdown report of one run: the Table 2 layout (eenf's rows with the best per column in
 /// bold, the paper's rows below), the recordings scored and failed, the per-recording rows.
-pub fn markdown_run(recs: &[Recording], run: &Run, methods: &[Method]) -> String {
+pub fn markdown_run(recs: &[DatasetEntry], run: &Run, methods: &[Method]) -> String {
     let mut s = markdown_table(run, methods);
     s.push_str("\nBold: best of eenf's rows per column. Means over the recordings scored; a recording where a method fails (no flicker found, no video, bad file) is counted as failed and left out of that mean.\n\n");
     s.push_str("| recording | method | CC | MAE (mHz) | RMSE (mHz) | max error (mHz) | seconds | run (s) | error |\n|---|---|---|---|---|---|---|---|---|\n");
@@ -131,7 +131,7 @@ pub const CSV_HEADER: &str =
 
 /// Writes the runs as CSV ([`CSV_HEADER`]): per run, one row per recording and method, then one
 /// `mean` row per class and method (recording `mean:<class>`, seconds = recordings scored).
-pub fn write_csv(w: &mut dyn std::io::Write, recs: &[Recording], runs: &[Run]) -> Result<()> {
+pub fn write_csv(w: &mut dyn std::io::Write, recs: &[DatasetEntry], runs: &[Run]) -> Result<()> {
     let mut out = csv::Writer::from_writer(w);
     out.write_record(CSV_HEADER.split(','))?;
     let num = |v: f64| {
@@ -191,7 +191,7 @@ pub fn write_csv(w: &mut dyn std::io::Write, recs: &[Recording], runs: &[Run]) -
 }
 
 /// The JSON of a run.
-pub fn json_run(recs: &[Recording], run: &Run) -> serde_json::Value {
+pub fn json_run(recs: &[DatasetEntry], run: &Run) -> serde_json::Value {
     let rows: Vec<serde_json::Value> = run
         .outcomes
         .iter()
@@ -269,7 +269,7 @@ pub struct ReportContext {
 /// The whole Markdown report.
 pub fn markdown_report(
     about: &ReportContext,
-    recs: &[Recording],
+    recs: &[DatasetEntry],
     runs: &[Run],
     methods: &[Method],
 ) -> String {
@@ -336,7 +336,7 @@ pub fn markdown_report(
 }
 
 /// A recording's file name without its extension: what its figures and traces are named by.
-pub fn stem(r: &Recording) -> String {
+pub fn stem(r: &DatasetEntry) -> String {
     r.path
         .file_stem()
         .unwrap_or_default()
@@ -354,7 +354,7 @@ fn run_dir(dir: &Path, runs: &[Run], k: usize) -> PathBuf {
 }
 
 /// Writes every kept trace as JSON into `dir` (one folder per run when there are several).
-pub fn write_traces(dir: &Path, recs: &[Recording], runs: &[Run]) -> Result<()> {
+pub fn write_traces(dir: &Path, recs: &[DatasetEntry], runs: &[Run]) -> Result<()> {
     for (k, run) in runs.iter().enumerate() {
         for o in &run.outcomes {
             let Some(d) = &o.details else { continue };

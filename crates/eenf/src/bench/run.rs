@@ -5,7 +5,7 @@ use eenf_dsp::{spectrogram, Agreement, Spectrogram};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::{class_rank, Method, Recording, Settings};
+use super::{class_rank, DatasetEntry, Method, Settings};
 use crate::evaluate::{compare, Comparison, Reference};
 use crate::extract::{extract_sampled, sample_file};
 use crate::progress::Progress;
@@ -42,7 +42,7 @@ pub struct Outcome {
 /// Errors are caught into the outcome: one bad recording does not stop a benchmark.
 pub fn evaluate(
     index: usize,
-    rec: &Recording,
+    rec: &DatasetEntry,
     method: Method,
     settings: &Settings,
     spectrum: bool,
@@ -70,7 +70,7 @@ pub fn evaluate(
 
 /// E-ENF on the recording's events.
 fn trace_events(
-    rec: &Recording,
+    rec: &DatasetEntry,
     s: &Settings,
     spectrum: bool,
 ) -> Result<(Trace, Option<Spectrogram>)> {
@@ -99,7 +99,7 @@ fn trace_events(
 }
 
 /// V-ENF on the recording's video from `camera`.
-fn trace_video(rec: &Recording, camera: &str, s: &Settings) -> Result<Trace> {
+fn trace_video(rec: &DatasetEntry, camera: &str, s: &Settings) -> Result<Trace> {
     let path = rec.video(camera).with_context(|| {
         format!(
             "{}: no {camera} video beside it (<stem>_{camera}.y4m/.mp4/…)",
@@ -109,7 +109,7 @@ fn trace_video(rec: &Recording, camera: &str, s: &Settings) -> Result<Trace> {
     crate::video::trace_video(path, &s.video, &Progress::hidden())
 }
 
-fn run_method(rec: &Recording, method: Method, s: &Settings, spectrum: bool) -> Result<Details> {
+fn run_method(rec: &DatasetEntry, method: Method, s: &Settings, spectrum: bool) -> Result<Details> {
     let (t, spectrogram) = match method.camera() {
         None => trace_events(rec, s, spectrum)?,
         Some(camera) => (trace_video(rec, camera, s)?, None),
@@ -173,7 +173,7 @@ pub struct ClassSummary {
 
 /// Means per class and method, classes in the paper's order.
 pub fn summarize(
-    recs: &[Recording],
+    recs: &[DatasetEntry],
     outcomes: &[Outcome],
     methods: &[Method],
 ) -> Vec<ClassSummary> {
@@ -238,7 +238,12 @@ impl Run {
 /// Recordings that fit the memory budget at once: the E-ENF sequence and its filtered copies
 /// (~48 bytes a sample at 1/Δt), or a video's row means (2 × 8 bytes a row, up to 1080 rows
 /// at 30 fps), whichever is larger; 600 s when the length is not known.
-pub fn jobs_for(recs: &[Recording], settings: &[Settings], budget_mb: u64, asked: usize) -> usize {
+pub fn jobs_for(
+    recs: &[DatasetEntry],
+    settings: &[Settings],
+    budget_mb: u64,
+    asked: usize,
+) -> usize {
     let longest = recs
         .iter()
         .map(|r| r.duration_s.unwrap_or(600.0))
@@ -256,7 +261,7 @@ pub fn jobs_for(recs: &[Recording], settings: &[Settings], budget_mb: u64, asked
 /// computes its E-ENF spectrograms. One [`Run`] per setting, summarised.
 #[allow(clippy::too_many_arguments)]
 pub fn run_all(
-    recs: &[Recording],
+    recs: &[DatasetEntry],
     methods: &[Method],
     settings: Vec<Settings>,
     jobs: usize,

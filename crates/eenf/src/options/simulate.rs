@@ -411,8 +411,9 @@ impl OptionSet for DatasetSettings {
 
 impl DatasetSettings {
     /// The build of a dataset into `out_dir`.
-    pub fn build(&self, out_dir: PathBuf) -> anyhow::Result<crate::dataset::DatasetBuild> {
-        use crate::dataset::{parse_local_hour, DatasetBuild, DatasetEnf, DatasetSpec};
+    pub fn build(&self, out_dir: PathBuf) -> anyhow::Result<crate::dataset_build::DatasetBuild> {
+        use crate::dataset::DatasetSpec;
+        use crate::dataset_build::{parse_local_hour, DatasetBuild, DatasetEnf};
         self.check()?;
         Ok(DatasetBuild {
             out_dir,

@@ -158,10 +158,7 @@ impl VideoSettings {
     /// The V-ENF options these settings ask for.
     pub fn options(&self) -> Result<VideoOptions, OptionError> {
         self.check()?;
-        let nominal_hz = match self.nominal {
-            Nominal::Hz(f) => Some(f),
-            Nominal::Auto => None,
-        };
+        let nominal_hz = self.nominal.hz();
         let positive = |name: &'static str, v: f64| {
             rule(name, format!("{} must be positive, not {v}", option(name)))
         };
@@ -438,10 +435,7 @@ impl StoreInputSettings {
                 zone: None,
                 unit: self.value_unit,
                 date_order: self.date_order,
-                nominal_hz: match self.nominal {
-                    Nominal::Hz(f) => Some(f),
-                    Nominal::Auto => None,
-                },
+                nominal_hz: self.nominal.hz(),
             },
             start,
             index_step_s: self.index_step,

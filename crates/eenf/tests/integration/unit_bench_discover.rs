@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 #[test]
 fn recordings_group_by_the_prominence_the_manifest_gives() {
-    let rec = |name: &str, p: Option<f64>| Recording {
+    let rec = |name: &str, p: Option<f64>| DatasetEntry {
         path: PathBuf::from(name),
         class: "camera".into(),
         reference: PathBuf::from("ref.csv"),

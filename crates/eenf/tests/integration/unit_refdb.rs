@@ -6,26 +6,29 @@ use eenf::refdb::*;
 #[test]
 fn series_merge_round_trip() {
     let dir = tempfile::tempdir().unwrap();
-    let mut s = RefSeries::new("g", 50.0, 1.0, 0.0);
+    let mut s = StoredGrid::new("g", 50.0, 1.0, 0.0);
     s.merge(100.0, 1.0, &[50.01, 49.99, f64::NAN]).unwrap();
     s.merge(110.0, 2.0, &[50.0, 50.002]).unwrap(); // resampled to 1 s: 3 values
     s.merge(98.0, 1.0, &[50.003]).unwrap(); // before the start: prepends a gap
     s.save(dir.path()).unwrap();
-    let l = RefSeries::load(dir.path(), "g").unwrap();
+    let l = StoredGrid::load(dir.path(), "g").unwrap();
     assert_eq!(l.meta.start_unix_s, 98.0);
     let hz = l.hz();
     assert_eq!(hz.len(), 15);
     assert!((hz[0] - 50.003).abs() < 1e-9 && hz[1].is_nan());
     assert!((hz[2] - 50.01).abs() < 1e-9 && (hz[3] - 49.99).abs() < 1e-9 && hz[4].is_nan());
     assert!((hz[13] - 50.001).abs() < 1e-9, "{hz:?}");
-    assert_eq!(RefSeries::grids(dir.path()).unwrap(), vec!["g".to_string()]);
+    assert_eq!(
+        StoredGrid::grids(dir.path()).unwrap(),
+        vec!["g".to_string()]
+    );
 }
 
 #[test]
 fn commits_replace_values_files_and_damage_is_found() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let mut s = RefSeries::new("grid50", 50.0, 1.0, 1000.0);
+    let mut s = StoredGrid::new("grid50", 50.0, 1.0, 1000.0);
     s.merge(1000.0, 1.0, &[50.01, 49.99, 50.0]).unwrap();
     s.save(d).unwrap();
     let first = s.meta.values_file.clone().unwrap();
@@ -35,20 +38,20 @@ fn commits_replace_values_files_and_damage_is_found() {
     // the commit moved to a new values file and removed the old one
     assert_ne!(first, second);
     assert!(!d.join(&first).exists() && d.join(&second).exists());
-    assert_eq!(RefSeries::load(d, "grid50").unwrap().values.len(), 4);
+    assert_eq!(StoredGrid::load(d, "grid50").unwrap().values.len(), 4);
     // a file left by a build killed before its commit is not the store's, and is cleaned
     std::fs::write(d.join("grid50.1.2.i32"), [0u8; 8]).unwrap();
-    assert_eq!(RefSeries::remove_orphans(d, "grid50").unwrap(), 1);
+    assert_eq!(StoredGrid::remove_orphans(d, "grid50").unwrap(), 1);
     assert!(d.join(&second).exists());
     // a flipped bit in the values is found by the checksum
     let mut bytes = std::fs::read(d.join(&second)).unwrap();
     bytes[5] ^= 0x10;
     std::fs::write(d.join(&second), &bytes).unwrap();
-    let e = RefSeries::load(d, "grid50").unwrap_err().to_string();
+    let e = StoredGrid::load(d, "grid50").unwrap_err().to_string();
     assert!(e.contains("checksum"), "{e}");
     // other JSON files beside the grids (a folder of hourly WAVs and their notes) are not grids
     std::fs::write(d.join("notes.json"), "{}").unwrap();
-    assert_eq!(RefSeries::grids(d).unwrap(), vec!["grid50".to_string()]);
+    assert_eq!(StoredGrid::grids(d).unwrap(), vec!["grid50".to_string()]);
 }
 
 #[test]
@@ -69,7 +72,7 @@ fn grid_names_are_plain_names() {
             "count": 0, "encoding": "i32"}"#,
     )
     .unwrap();
-    let e = RefSeries::load(&d, "grid50").unwrap_err().to_string();
+    let e = StoredGrid::load(&d, "grid50").unwrap_err().to_string();
     assert!(e.contains("../escaped"), "{e}");
     assert!(!dir.path().join("escaped.json").exists());
 }

@@ -1,4 +1,5 @@
-//! Building a simulated dataset (`simulate-dataset`, Python's `simulate_dataset`): every
+//! Building a simulated dataset (`simulate-dataset`, Python's `simulate_dataset`) from its
+//! plan ([`crate::dataset`]) and the simulator ([`crate::simulation`]): every
 //! planned recording written with its truth, videos and metadata, the hourly references that
 //! cover them, `manifest.csv` and `dataset.json`, into a folder that is never left half-built.
 
@@ -10,7 +11,7 @@ use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;
 use eenf_sim::CameraConfig;
 
-use super::{
+use crate::dataset::{
     plan_dataset, recording_name, reference_name, relative, scored_against_truth, DatasetSpec,
     PlannedRecording, BUILDING_MARKER,
 };

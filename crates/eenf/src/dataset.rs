@@ -11,9 +11,6 @@ use rand::{Rng, SeedableRng};
 
 use crate::time::LocalTime;
 
-pub mod build;
-pub use build::{build_dataset, parse_local_hour, DatasetBuild, DatasetBuilt, DatasetEnf};
-
 /// The dataset's recording name, `dvSave-YYYY_MM_DD_HH_MM_SS.<ext>`.
 pub fn recording_name(t: &LocalTime, ext: &str) -> String {
     format!(
