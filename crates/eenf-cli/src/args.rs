@@ -815,7 +815,7 @@ pub fn option_docs() -> serde_json::Value {
                 let help = a
                     .get_long_help()
                     .or(a.get_help())
-                    .map(|h| h.to_string())
+                    .map(|h| library_names(&h.to_string()))
                     .unwrap_or_default();
                 let choices: Vec<String> = a
                     .get_possible_values()
@@ -834,4 +834,27 @@ pub fn option_docs() -> serde_json::Value {
         out.insert(name.to_string(), options.into());
     }
     out.into()
+}
+
+/// `text` with each flag it names (`--max-gap`) as the option's library name (`max_gap`), for
+/// the front ends that do not take flags.
+fn library_names(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find("--") {
+        out.push_str(&rest[..at]);
+        let tail = &rest[at + 2..];
+        let len = tail
+            .find(|c: char| !(c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-'))
+            .unwrap_or(tail.len());
+        if tail.starts_with(|c: char| c.is_ascii_lowercase()) {
+            out.push_str(&tail[..len].replace('-', "_"));
+            rest = &tail[len..];
+        } else {
+            out.push_str("--");
+            rest = tail;
+        }
+    }
+    out.push_str(rest);
+    out
 }

@@ -113,6 +113,11 @@ def test_help_lists_the_parameters_with_their_defaults():
         assert needle in doc, needle
     assert "channel (default mix)" in eenf.reference.__doc__
     assert "duration (default 60)" in eenf.simulate.__doc__
+    assert "preset (default ev-enfd)" in eenf.simulate_dataset.__doc__
+    # the help names keyword arguments, never the command line's flags
+    for fn in [eenf.extract, eenf.reference, eenf.simulate, eenf.edits, eenf.match]:
+        params = fn.__doc__.split("Keyword parameters", 1)[1]
+        assert "--" not in params, fn.__name__
 
 
 def test_video_equals_the_command_line(cli, tmp_path):

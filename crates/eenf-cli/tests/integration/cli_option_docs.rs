@@ -17,6 +17,12 @@ fn option_docs_match_the_flags() {
         options::DOCS_JSON == want,
         "{DOCS_FILE} differs from the flags' help: run EENF_BLESS=1 cargo test --release -p eenf-cli option_docs"
     );
+    // the help that Python and the page show names options as they take them, not as flags
+    assert!(!want.contains("--"), "a flag in the options' help");
+    assert!(
+        want.contains("more than max_gap"),
+        "the help's flags are library names"
+    );
 }
 
 /// The library's sets behind each documented set.
