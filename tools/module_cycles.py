@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Fails when the top-level modules of a crate import each other in a circle, or when the
 library crate `eenf` depends on the command line's crates (clap, indicatif, plotters,
-signal-hook) or `eenf-dsp` on `eenf-events`.
+signal-hook), the Python package `eenf-py` on the command line (`eenf-cli`, clap, indicatif,
+signal-hook), or `eenf-dsp` on `eenf-events`.
 
 A module's imports are its `crate::NAME` paths, names re-exported by `lib.rs` resolved to the
 module that defines them. Usage: python3 tools/module_cycles.py [ROOT]"""
@@ -84,6 +85,8 @@ def main():
     for package, banned in [
         ("eenf", ["clap", "indicatif", "plotters", "signal-hook"]),
         ("eenf-dsp", ["eenf-events"]),
+        # the Python package is a front end over the library, not over the command line
+        ("eenf-py", ["clap", "indicatif", "signal-hook", "eenf-cli"]),
     ]:
         tree = subprocess.run(
             ["cargo", "tree", "-p", package, "-e", "normal", "--prefix", "none"],
