@@ -186,15 +186,8 @@ pub(crate) fn maybe<T>(
 
 /// Refuses `v` outside `lo..=hi` (NaN and infinities too).
 pub(crate) fn within(name: &'static str, v: f64, (lo, hi): (f64, f64)) -> Result<(), OptionError> {
-    if v.is_finite() && (lo..=hi).contains(&v) {
-        Ok(())
-    } else {
-        Err(OptionError::Invalid {
-            name,
-            value: v.to_string(),
-            reason: format!("{v} is outside {lo}..={hi}"),
-        })
-    }
+    let inside = v.is_finite() && (lo..=hi).contains(&v);
+    inside.then_some(()).ok_or_else(|| outside(name, v, lo, hi))
 }
 
 /// Refuses a whole number outside `lo..=hi`.
@@ -203,14 +196,21 @@ pub(crate) fn counted<T: Into<i128> + Copy + fmt::Display>(
     v: T,
     (lo, hi): (T, T),
 ) -> Result<(), OptionError> {
-    if (lo.into()..=hi.into()).contains(&v.into()) {
-        Ok(())
-    } else {
-        Err(OptionError::Invalid {
-            name,
-            value: v.to_string(),
-            reason: format!("{v} is outside {lo}..={hi}"),
-        })
+    let inside = (lo.into()..=hi.into()).contains(&v.into());
+    inside.then_some(()).ok_or_else(|| outside(name, v, lo, hi))
+}
+
+/// Option `name`'s value `v` lies outside `lo..=hi`.
+fn outside(
+    name: &'static str,
+    v: impl fmt::Display,
+    lo: impl fmt::Display,
+    hi: impl fmt::Display,
+) -> OptionError {
+    OptionError::Invalid {
+        name,
+        value: v.to_string(),
+        reason: format!("{v} is outside {lo}..={hi}"),
     }
 }
 
