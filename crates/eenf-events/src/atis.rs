@@ -118,7 +118,6 @@ pub fn reader(src: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventReader>>
 /// The headerless ATIS `.bin` for probing ([`crate::registry`]), last: whole 5-byte words
 /// whose times never go back.
 pub const REGISTERED: crate::Registered = crate::Registered {
-    name: "ATIS .bin",
     probe: |head, src, path| {
         let len = src
             .seek(std::io::SeekFrom::End(0))

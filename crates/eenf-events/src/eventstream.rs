@@ -142,7 +142,6 @@ pub fn reader(mut src: Box<dyn Source>, path: &Path) -> Result<Box<dyn EventRead
 
 /// Event Stream for probing ([`crate::registry`]): its magic.
 pub const REGISTERED: crate::Registered = crate::Registered {
-    name: "Event Stream",
     probe: |head, _, _| {
         Ok(crate::registry::by_magic(
             head,

@@ -453,7 +453,6 @@ impl EventReader for Aedat31Reader {
 
 /// jAER AEDAT 2.0 for probing ([`crate::registry`]): its `#!AER-DAT2.0` line.
 pub const AEDAT2: crate::Registered = crate::Registered {
-    name: "AEDAT 2.0",
     probe: |head, _, _| {
         Ok(crate::registry::by_magic(
             head,
@@ -466,7 +465,6 @@ pub const AEDAT2: crate::Registered = crate::Registered {
 
 /// jAER AEDAT 3.1 for probing ([`crate::registry`]): its `#!AER-DAT3` line.
 pub const AEDAT31: crate::Registered = crate::Registered {
-    name: "AEDAT 3.1",
     probe: |head, _, _| {
         Ok(crate::registry::by_magic(
             head,

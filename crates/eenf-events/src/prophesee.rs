@@ -429,7 +429,6 @@ impl Skips {
 /// encoding (or a DAT whose data starts with type 0 and size 8). The header is read once and
 /// handed to the reader.
 pub const REGISTERED: crate::Registered = crate::Registered {
-    name: "Prophesee RAW/DAT",
     probe: probe_registered,
     open: open_registered,
 };

@@ -48,10 +48,8 @@ pub type ProbeFn = fn(&Head, &mut dyn Source, &Path) -> Result<Option<Probed>>;
 /// Opens the reader of a stream its probe recognised.
 pub type OpenFn = fn(Box<dyn Source>, &Path, &OpenOptions, Probed) -> Result<Box<dyn EventReader>>;
 
-/// One format: its name, its probe and its reader.
+/// One format: its probe and its reader (the entry's doc comment names the format).
 pub struct Registered {
-    /// What the format is called in messages.
-    pub name: &'static str,
     /// Recognises it.
     pub probe: ProbeFn,
     /// Opens its reader.

@@ -458,7 +458,6 @@ impl BagReader {
 
 /// ROS 1 bags for probing ([`crate::registry`]): the `#ROSBAG V2.0` line.
 pub const REGISTERED: crate::Registered = crate::Registered {
-    name: "ROS 1 bag",
     probe: |head, _, _| {
         Ok(crate::registry::by_magic(
             head,

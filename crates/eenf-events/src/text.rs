@@ -269,7 +269,6 @@ impl EventReader for TextReader {
 /// Text for probing ([`crate::registry`]): no NUL byte, and the first event line (after
 /// comments and a line of column names) holds four numbers. Only complete lines are judged.
 pub const REGISTERED: crate::Registered = crate::Registered {
-    name: "text",
     probe: |head, _, _| {
         let found = looks_like_text(head.bytes, head.cut);
         Ok(found.then(|| crate::Probed::of(crate::Format::Text)))

@@ -702,7 +702,6 @@ impl EventReader for Aedat4Reader {
 
 /// AEDAT 4.0 for probing ([`crate::registry`]): its magic line.
 pub const REGISTERED: crate::Registered = crate::Registered {
-    name: "AEDAT 4.0",
     probe: |head, _, _| {
         Ok(crate::registry::by_magic(
             head,

@@ -673,7 +673,6 @@ impl EventReader for Hdf5Reader {
 
 /// HDF5 for probing ([`crate::registry`]): its signature.
 pub const REGISTERED: crate::Registered = crate::Registered {
-    name: "HDF5",
     probe: |head, _, _| Ok(crate::registry::by_magic(head, MAGIC, crate::Format::Hdf5)),
     open: |src, path, opts, _| reader(src, path, opts.camera),
 };

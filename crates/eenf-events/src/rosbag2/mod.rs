@@ -877,7 +877,6 @@ impl McapFile {
 
 /// rosbag2 storage files for probing ([`crate::registry`]): SQLite's or MCAP's magic.
 pub const REGISTERED: crate::Registered = crate::Registered {
-    name: "rosbag2",
     probe: |head, _, _| {
         let found = head.starts_with(SQLITE_MAGIC) || head.starts_with(MCAP_MAGIC);
         Ok(found.then(|| crate::Probed::of(crate::Format::Rosbag2)))
