@@ -332,12 +332,11 @@ impl TraceOutputArgs {
         let stdout = std::io::stdout();
         let mut lock = stdout.lock();
         if self.json {
-            trace.write_json(&mut lock)
+            trace.write_json(&mut lock)?;
         } else if self.output.is_none() {
-            trace.write_csv(&mut lock)
-        } else {
-            Ok(())
+            trace.write_csv(&mut lock)?;
         }
+        Ok(())
     }
 
     /// Says where the trace and the figure went, and which of the trace's estimates stand at

@@ -115,16 +115,19 @@ fn main() -> ExitCode {
         Err(e) => {
             // a reader that went away (`| head`) ends the program quietly
             let closed = e.chain().any(|c| {
-                let io = c.downcast_ref::<std::io::Error>().or_else(|| {
-                    match c.downcast_ref::<csv::Error>().map(csv::Error::kind) {
-                        Some(csv::ErrorKind::Io(io)) => Some(io),
-                        _ => None,
-                    }
-                });
+                let io = c.downcast_ref::<std::io::Error>().map(std::io::Error::kind);
+                let csv = match c.downcast_ref::<csv::Error>().map(csv::Error::kind) {
+                    Some(csv::ErrorKind::Io(io)) => Some(io.kind()),
+                    _ => None,
+                };
                 let json = c
                     .downcast_ref::<serde_json::Error>()
                     .and_then(serde_json::Error::io_error_kind);
-                io.map(std::io::Error::kind).or(json) == Some(std::io::ErrorKind::BrokenPipe)
+                // the library's errors find the OS's error wherever it sits in them
+                let library = c
+                    .downcast_ref::<eenf::Error>()
+                    .and_then(eenf::Error::io_kind);
+                io.or(csv).or(json).or(library) == Some(std::io::ErrorKind::BrokenPipe)
             });
             if closed {
                 return ExitCode::SUCCESS;

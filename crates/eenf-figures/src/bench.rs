@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
 use eenf::bench::report::stem;
 use eenf::bench::{paper_value, DatasetEntry, Method, Outcome, Run};
+use eenf::error::{Context, Result};
 use eenf::progress::Progress;
 
 use crate::{plot_extraction, plot_methods, plot_spectrogram, plot_summary, Series, SummaryBar};

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::{anyhow, bail, Result};
+use eenf::{Error, Result};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -18,8 +18,8 @@ pub(crate) const PALETTE: [RGBColor; 6] = [
     RGBColor(227, 119, 194),
 ];
 
-pub(crate) fn e<T: std::fmt::Display>(err: T) -> anyhow::Error {
-    anyhow!("drawing failed: {err}")
+pub(crate) fn e<T: std::fmt::Display>(err: T) -> Error {
+    Error::Output(format!("drawing failed: {err}"))
 }
 
 /// Registers the bundled font as plotters' `sans-serif` (once per process).
@@ -32,7 +32,7 @@ pub(crate) fn fonts() -> Result<()> {
     if *ok {
         Ok(())
     } else {
-        bail!("the bundled font could not be loaded")
+        Err(Error::Output("the bundled font could not be loaded".into()))
     }
 }
 
@@ -49,7 +49,10 @@ pub(crate) fn render(
         .unwrap_or_default();
     fonts()?;
     if !matches!(ext.as_str(), "png" | "svg") {
-        bail!("{}: plots are written as .png or .svg", path.display());
+        return Err(Error::Output(format!(
+            "{}: plots are written as .png or .svg",
+            path.display()
+        )));
     }
     let out = eenf::output::AtomicFile::keeping_extension(path)?;
     let res = match ext.as_str() {
@@ -65,10 +68,15 @@ pub(crate) fn render(
             let root = SVGBackend::new(out.path(), SIZE).into_drawing_area();
             draw_svg(&root).and_then(|_| root.present().map_err(e))
         }
-        _ => bail!("{}: plots are written as .png or .svg", path.display()),
+        _ => {
+            return Err(Error::Output(format!(
+                "{}: plots are written as .png or .svg",
+                path.display()
+            )))
+        }
     };
     match res {
-        Ok(()) => out.commit(),
+        Ok(()) => Ok(out.commit()?),
         Err(err) => Err(err.context(format!("{}: cannot draw the plot", path.display()))),
     }
 }

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use eenf::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
-use anyhow::Result;
 use eenf::trace::Trace;
+use eenf::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use eenf::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -19,7 +19,7 @@ fn spectrogram_chart<DB: DrawingBackend>(
     let root = root.titled(title, ("sans-serif", 22)).map_err(e)?;
     let (nt, nf) = (s.time_s.len(), s.freq_hz.len());
     if nt == 0 || nf == 0 {
-        bail!("empty spectrogram");
+        return Err(Error::Method("empty spectrogram".into()));
     }
     let dt = if nt > 1 {
         s.time_s[1] - s.time_s[0]

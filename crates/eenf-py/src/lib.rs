@@ -31,18 +31,12 @@ const RECORD: usize = 13;
 /// the OS error's kind, e.g. `FileNotFoundError`) when a file could not be read or written,
 /// `ValueError` for bad data or parameters. Messages name options as keyword arguments (the
 /// module sets that spelling when it loads).
-fn py_err(e: anyhow::Error) -> PyErr {
-    let msg = format!("{e:#}");
-    for cause in e.chain() {
-        let kind = match cause.downcast_ref::<eenf_events::EventError>() {
-            Some(eenf_events::EventError::Io { error, .. }) => Some(error.kind()),
-            _ => cause.downcast_ref::<std::io::Error>().map(|e| e.kind()),
-        };
-        if let Some(kind) = kind {
-            return PyErr::from(std::io::Error::new(kind, msg));
-        }
+fn py_err(e: eenf::Error) -> PyErr {
+    let msg = e.report();
+    match e.io_kind() {
+        Some(kind) => PyErr::from(std::io::Error::new(kind, msg)),
+        None => PyValueError::new_err(msg),
     }
-    PyValueError::new_err(msg)
 }
 
 fn events_err(e: eenf_events::EventError) -> PyErr {
@@ -339,7 +333,7 @@ impl PyTrace {
     }
 }
 
-fn traced(r: anyhow::Result<Trace>) -> PyResult<PyTrace> {
+fn traced(r: eenf::Result<Trace>) -> PyResult<PyTrace> {
     r.map(|t| PyTrace(Arc::new(t))).map_err(py_err)
 }
 
@@ -664,7 +658,7 @@ type EditsOut<'py> = (
     Bound<'py, PyArray1<f64>>,
 );
 
-fn edits_out(py: Python<'_>, r: anyhow::Result<eenf::edits::EditReport>) -> PyResult<EditsOut<'_>> {
+fn edits_out(py: Python<'_>, r: eenf::Result<eenf::edits::EditReport>) -> PyResult<EditsOut<'_>> {
     let r = r.map_err(py_err)?;
     let s = r.series.clone();
     Ok((

@@ -7,7 +7,7 @@ use std::io::Read;
 use std::path::Path;
 use std::process::{Command, Stdio};
 
-use anyhow::{anyhow, bail, Context, Result};
+use crate::error::{error, fail, Context, Error, Result};
 use eenf_dsp::StreamDecimator;
 use symphonia::core::audio::SampleBuffer;
 use symphonia::core::codecs::{DecoderOptions, CODEC_TYPE_NULL};
@@ -92,7 +92,10 @@ impl Sink {
     fn new(channel: Channel, channels: usize, fs: f64, top_hz: Option<f64>) -> Result<Self> {
         if let Channel::Index(i) = channel {
             if i >= channels {
-                bail!("channel {i} asked for, but the recording has {channels}");
+                fail!(
+                    Input,
+                    "channel {i} asked for, but the recording has {channels}"
+                );
             }
         }
         Ok(Sink {
@@ -155,20 +158,20 @@ impl Audio {
 /// sound is an error.
 pub fn read_audio(path: &Path, opts: &AudioOptions) -> Result<Audio> {
     if path.is_dir() {
-        bail!("{}: is a folder, not a recording", path.display());
+        fail!(Input, "{}: is a folder, not a recording", path.display());
     }
     let mut file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
     match container_of(&mut file) {
         // Symphonia's Matroska reader panics on cut-short files and allocates whatever a lace
         // size says (0.5.5): MKV and WebM go to ffmpeg, which reads them robustly
         Container::Matroska => {
-            return read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {e}", path.display()))
+            return read_ffmpeg(path, opts).map_err(|e| error!(Input, "{}: {e}", path.display()))
         }
         // its MP4 reader can allocate from damaged box sizes past the memory there is (an
         // abort no panic guard catches): MP4, M4A and MOV go to ffmpeg, always, so that a file
         // gives one trace whether or not ffmpeg is installed (or a clear error without it)
         Container::Mp4 => {
-            return read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {e}", path.display()))
+            return read_ffmpeg(path, opts).map_err(|e| error!(Input, "{}: {e}", path.display()))
         }
         _ => {}
     }
@@ -179,7 +182,7 @@ pub fn read_audio(path: &Path, opts: &AudioOptions) -> Result<Audio> {
     match symphonia {
         Ok(a) => Ok(a),
         Err(Unreadable::Format(why)) => {
-            read_ffmpeg(path, opts).map_err(|e| anyhow!("{}: {why}; {e}", path.display()))
+            read_ffmpeg(path, opts).map_err(|e| error!(Input, "{}: {why}; {e}", path.display()))
         }
         Err(Unreadable::Other(e)) => Err(e),
     }
@@ -267,20 +270,23 @@ pub fn audio_from_samples(
     opts: &AudioOptions,
 ) -> Result<Audio> {
     if !(fs.is_finite() && fs > 0.0 && fs <= MAX_RATE_HZ) {
-        bail!(
+        fail!(
+            Input,
             "{}: the sample rate must be above 0 and at most {MAX_RATE_HZ} Hz, not {fs}",
             name.display()
         );
     }
     if channels == 0 || !interleaved.len().is_multiple_of(channels) {
-        bail!(
+        fail!(
+            Input,
             "{}: {} samples do not make whole frames of {channels} channels",
             name.display(),
             interleaved.len()
         );
     }
     if let Some(i) = interleaved.iter().position(|v| !v.is_finite()) {
-        bail!(
+        fail!(
+            Input,
             "{}: sample {} (frame {}) is {}: samples must be finite",
             name.display(),
             i,
@@ -300,7 +306,7 @@ pub fn audio_from_samples(
 /// error (bad channel, damaged stream).
 enum Unreadable {
     Format(String),
-    Other(anyhow::Error),
+    Other(Error),
 }
 
 fn read_symphonia(
@@ -308,8 +314,8 @@ fn read_symphonia(
     path: &Path,
     opts: &AudioOptions,
 ) -> std::result::Result<Audio, Unreadable> {
-    let other = |e: anyhow::Error| Unreadable::Other(anyhow!("{}: {e}", path.display()));
-    let file = crate::flac_mask::flac_masked(file).map_err(|why| other(anyhow!(why)))?;
+    let other = |e: Error| Unreadable::Other(error!(Input, "{}: {e}", path.display()));
+    let file = crate::flac_mask::flac_masked(file).map_err(|why| other(Error::Input(why)))?;
     let mss = MediaSourceStream::new(Box::new(file), Default::default());
     let mut hint = Hint::new();
     if let Some(ext) = path.extension().and_then(|e| e.to_str()) {
@@ -342,7 +348,8 @@ fn read_symphonia(
         .map_err(|_| Unreadable::Format("its audio codec is not one eenf decodes itself".into()))?;
     let fs = params.sample_rate.unwrap_or(0) as f64;
     if fs <= 0.0 {
-        return Err(Unreadable::Other(anyhow!(
+        return Err(Unreadable::Other(error!(
+            Input,
             "{}: its header gives a sample rate of 0 Hz",
             path.display()
         )));
@@ -355,7 +362,7 @@ fn read_symphonia(
             Ok(p) => p,
             Err(SymError::IoError(e)) if e.kind() == std::io::ErrorKind::UnexpectedEof => break,
             Err(SymError::ResetRequired) => break,
-            Err(e) => return Err(other(anyhow!("damaged stream ({e})"))),
+            Err(e) => return Err(other(error!(Input, "damaged stream ({e})"))),
         };
         if packet.track_id() != track_id {
             continue;
@@ -367,7 +374,7 @@ fn read_symphonia(
                 continue;
             }
             Err(SymError::IoError(e)) if e.kind() == std::io::ErrorKind::UnexpectedEof => break,
-            Err(e) => return Err(other(anyhow!("cannot decode its audio ({e})"))),
+            Err(e) => return Err(other(error!(Input, "cannot decode its audio ({e})"))),
         };
         let spec = *decoded.spec();
         let channels = spec.channels.count();
@@ -402,7 +409,7 @@ fn finish(
     warning: Option<String>,
 ) -> Result<Audio> {
     let Some(s) = sink.filter(|s| s.frames > 0) else {
-        bail!("{}: the recording holds no sound", path.display());
+        fail!(Input, "{}: the recording holds no sound", path.display());
     };
     // the decimator's delay taken back out, so sample 0 is the recording's start
     let lag = (s.decimator.delay_s() * s.decimator.fs_out()).round() as usize;
@@ -431,9 +438,9 @@ fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
         .output()
         .map_err(|e| match e.kind() {
             std::io::ErrorKind::NotFound => {
-                anyhow!("ffmpeg (ffprobe) is not installed, and it is needed for this file (Debian: apt install ffmpeg)")
+                error!(Input, "ffmpeg (ffprobe) is not installed, and it is needed for this file (Debian: apt install ffmpeg)")
             }
-            _ => anyhow!("ffprobe: {e}"),
+            _ => error!(Input, "ffprobe: {e}"),
         })?;
     let text = String::from_utf8_lossy(&probe.stdout);
     let mut fields = text.trim().split(',');
@@ -441,13 +448,16 @@ fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
         fields.next().map(|v| v.trim().parse::<u32>()),
         fields.next().map(|v| v.trim().parse::<usize>()),
     ) else {
-        bail!("ffmpeg finds no audio stream in it");
+        fail!(Input, "ffmpeg finds no audio stream in it");
     };
     if fs == 0 || channels == 0 {
-        bail!("ffmpeg finds no audio stream in it");
+        fail!(Input, "ffmpeg finds no audio stream in it");
     }
     if channels > 64 {
-        bail!("ffmpeg reports {channels} audio channels: a damaged header (64 at most are read)");
+        fail!(
+            Input,
+            "ffmpeg reports {channels} audio channels: a damaged header (64 at most are read)"
+        );
     }
     let mut child = Command::new("ffmpeg")
         .args(["-v", "error", "-nostdin", "-i"])
@@ -465,7 +475,7 @@ fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .map_err(|e| anyhow!("ffmpeg: {e}"))?;
+        .map_err(|e| error!(Input, "ffmpeg: {e}"))?;
     // ffmpeg's messages are read on a thread of their own as they come: a pipe holds 64 KiB,
     // and ffmpeg blocked on a full stderr would never finish our stdout. The last lines are
     // kept for the error.
@@ -479,7 +489,8 @@ fn read_ffmpeg(path: &Path, opts: &AudioOptions) -> Result<Audio> {
     let err = messages.join().unwrap_or_default();
     let sink = result?;
     if !status.success() {
-        bail!(
+        fail!(
+            Input,
             "ffmpeg could not decode it: {}",
             err.lines().last().unwrap_or("no message")
         );

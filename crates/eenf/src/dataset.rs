@@ -5,7 +5,7 @@
 use eenf_core::spelling::option;
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use crate::error::{fail, rule, Context, Result};
 use eenf_sim::{Lamp, LampKind, Readout, SceneKind, SimConfig};
 use rand::{Rng, SeedableRng};
 
@@ -80,7 +80,8 @@ pub fn hourly_references(dir: &Path) -> Result<Vec<(LocalTime, PathBuf)>> {
     }
     out.sort();
     if out.is_empty() {
-        bail!(
+        fail!(
+            Input,
             "{}: no hourly reference WAVs named like 2022_08_17_Wed_16_00_00.wav",
             dir.display()
         );
@@ -266,10 +267,15 @@ fn preset(name: &str) -> Result<(Classes, f64, (u16, u16))> {
                 .collect();
             return Ok((plans, 40.0, (64, 64)));
         }
-        other => bail!(
-            "{} {other:?}: expected ev-enfd, small or lamp-spot",
-            option("preset")
-        ),
+        other => {
+            return Err(rule(
+                "preset",
+                format!(
+                    "{} {other:?}: expected ev-enfd, small or lamp-spot",
+                    option("preset")
+                ),
+            ))
+        }
     };
     let mut plans = cycle("static", n[0], &[&[Static]]);
     plans.extend(cycle("dynamic", n[1], dynamic));
@@ -288,12 +294,16 @@ pub fn plan_dataset(
     let (classes, preset_duration, preset_res) = preset(&spec.preset)?;
     let duration = spec.duration_s.unwrap_or(preset_duration);
     if !(20.0..=3600.0).contains(&duration) {
-        bail!("{} must be between 20 and 3600 s", option("duration"));
+        return Err(rule(
+            "duration",
+            format!("{} must be between 20 and 3600 s", option("duration")),
+        ));
     }
     let (width, height) = spec.resolution.unwrap_or(preset_res);
     let (lo, hi) = (from.ceil() as i64 + 30, (to - duration).floor() as i64 - 30);
     if hi <= lo + classes.len() as i64 {
-        bail!(
+        fail!(
+            Input,
             "the ENF covers {:.0} s, too little for {} recordings of {duration} s",
             to - from,
             classes.len()
@@ -368,7 +378,7 @@ pub fn check_complete(dataset: &Path) -> Result<()> {
         crate::output::folder_of(dataset)
     };
     if dir.join(BUILDING_MARKER).exists() {
-        bail!(
+        fail!(Input,
             "{}: simulate-dataset did not finish building this dataset (it holds {BUILDING_MARKER}); build it again",
             dir.display()
         );

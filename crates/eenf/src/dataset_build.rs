@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use crate::error::{rule, Context, Result};
 use eenf_core::spelling::option;
 use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;
@@ -70,9 +70,12 @@ pub struct DatasetBuilt {
 /// Local seconds of a local date and hour like `2022-08-17T16` (minutes, if any, ignored).
 pub fn parse_local_hour(s: &str) -> Result<i64> {
     let bad = || {
-        anyhow::anyhow!(
-            "{} {s:?}: expected a local date and hour like 2022-08-17T16",
-            option("start")
+        rule(
+            "start",
+            format!(
+                "{} {s:?}: expected a local date and hour like 2022-08-17T16",
+                option("start")
+            ),
         )
     };
     let (date, hour) = s.split_once(['T', ' ']).ok_or_else(bad)?;
@@ -108,7 +111,7 @@ pub fn build_dataset(
             from_local_s,
         } => {
             if *grid_hz != 50.0 && *grid_hz != 60.0 {
-                bail!("{} must be 50 or 60", option("grid"));
+                return Err(rule("grid", format!("{} must be 50 or 60", option("grid"))));
             }
             let from = *from_local_s as f64;
             EnfTimeline::synthetic(*grid_hz, from, from + 6.0 * 3600.0, b.spec.seed ^ 0xe4f)

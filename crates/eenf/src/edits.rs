@@ -11,7 +11,7 @@
 use eenf_core::spelling::option;
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, bail, Result};
+use crate::error::{error, fail, Error, Result};
 use eenf_dsp::edits::{baseband, scan_phase, wrap, Baseband, BoundaryTest, PhaseScan};
 use eenf_dsp::hum::{MAX_HUM_HARMONIC, MIN_CLIP_S};
 use eenf_dsp::search_hum;
@@ -288,7 +288,7 @@ pub struct SoundHum {
 /// refused, as `audio` refuses it).
 pub fn sound_baseband(sound: &Sound, audio: &AudioOptions, nominal: Nominal) -> Result<SoundHum> {
     let path = sound.name();
-    let err = |e: eenf_dsp::DspError| anyhow!("{}: {e}", path.display());
+    let err = |e: eenf_dsp::DspError| Error::from(e).context(path.display());
     let grids = grids_of(nominal);
     let top_grid = grids.iter().fold(0.0f64, |a, &b| a.max(b));
     let top_of = |k: usize| k as f64 * top_grid + 10.0;
@@ -305,7 +305,7 @@ pub fn sound_baseband(sound: &Sound, audio: &AudioOptions, nominal: Nominal) -> 
     }
     let search = search_hum(&a.signal.samples, a.signal.fs, 1.0, grids, MAX_HUM_HARMONIC)
         .ok_or_else(|| {
-            anyhow!(
+            error!(Method,
                 "{}: sample rate {} Hz is too low to carry a mains line with its noise floor beside it",
                 path.display(),
                 a.signal.fs
@@ -333,7 +333,7 @@ pub fn event_edits(
     progress: &Progress,
 ) -> Result<EditReport> {
     let path = rec.name();
-    let err = |e: eenf_dsp::DspError| anyhow!("{}: {e}", path.display());
+    let err = |e: eenf_dsp::DspError| Error::from(e).context(path.display());
     let s = sample_recording(rec, opts, progress)?;
     let seq = &s.seq;
     let grids = grids_of(opts.nominal);
@@ -343,7 +343,7 @@ pub fn event_edits(
     let (x, fs) = flicker_signal(seq, 2.0 * top_grid * FLICKER_LINES as f64 + 10.0);
     let duration_s = seq.duration_s();
     let search = search_hum(&x, fs, 2.0, grids, FLICKER_LINES).ok_or_else(|| {
-        anyhow!(
+        error!(Method,
             "{}: the recording ({duration_s:.1} s, flicker sampled at {fs} Hz) is too short or too coarse to hold a flicker line",
             path.display()
         )
@@ -382,7 +382,8 @@ pub fn trace_edits(trace: &Trace, path: &Path, params: &EditParams) -> Result<Ed
     // several mHz, over 5 s by one
     let side = ((params.side_s.min(TRACE_SIDE_S) / step).round() as usize).max(3);
     if n < 2 * side + 1 {
-        bail!(
+        fail!(
+            Method,
             "{}: the trace holds {n} estimates ({:.0} s); frequency steps need at least {:.0} s",
             path.display(),
             n as f64 * step,
@@ -474,8 +475,8 @@ pub fn trace_edits(trace: &Trace, path: &Path, params: &EditParams) -> Result<Ed
     })
 }
 
-fn too_short(path: &Path, duration_s: f64, params: &EditParams) -> anyhow::Error {
-    anyhow!(
+fn too_short(path: &Path, duration_s: f64, params: &EditParams) -> Error {
+    error!(Method,
         "{}: the recording lasts {duration_s:.2} s; the phase test needs at least {:.1} s (twice {})",
         path.display(),
         2.0 * params.min_gap_s,

@@ -5,7 +5,7 @@
 use eenf_core::spelling::option;
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use crate::error::{fail, Error, Missing, Result};
 use eenf_dsp::{agreement, Agreement, EnfParams};
 
 use crate::dataset::{recording_start, reference_hour};
@@ -53,19 +53,19 @@ impl Reference {
     ) -> Result<(Reference, f64)> {
         let source = ReferenceSource::open(path)?;
         if let ReferenceSource::Store(dir) = &source {
-            bail!(
+            fail!(Method,
                 "{}: a reference store: `match` searches stores; compare takes a trace, a WAV or a folder of hourly WAVs",
                 dir.display()
             );
         }
         if let ReferenceSource::Archive(p) = &source {
-            bail!(
+            fail!(Method,
                 "{}: a grid archive: add it to a store with `refdb build` and search it with `match`",
                 p.display()
             );
         }
         if let ReferenceSource::HourlyFolder(_) = source {
-            let start = recording_start(recording).with_context(|| {
+            let start = recording_start(recording).or_fail(Error::Input, || {
                 format!(
                     "{}: cannot tell when the recording started: its name has no dvSave-YYYY_MM_DD_HH_MM_SS",
                     recording.display()
@@ -91,7 +91,7 @@ impl Reference {
             // placed by its name, as in a folder (the next hour's file is read if it runs on)
             (Some(hour), Some(start)) if offset_s == 0.0 => {
                 if start.hour_index() != hour.hour_index() {
-                    bail!(
+                    fail!(Method,
                         "{}: the recording {} starts at {} {:02}:{:02}:{:02}, outside this hour's reference (pass the folder of hourly WAVs, or {})",
                         path.display(),
                         recording.display(),
@@ -201,7 +201,8 @@ pub fn compare_with(
 ) -> Result<Comparison> {
     let (t, e, ref_v) = align(time_s, enf_hz, &r.time_s, &r.enf_hz, offset_s);
     let Some(agreement) = agreement(&e, &ref_v) else {
-        bail!(
+        fail!(
+            Method,
             "{} and its reference share fewer than two seconds at offset {offset_s} s",
             what.display()
         );

@@ -3,7 +3,7 @@
 use eenf_core::spelling::option;
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use crate::error::{error, fail, Error, Result};
 use eenf_dsp::{
     check_line, decimate, decimation_for, detect_nominal, enf_from_flicker, flicker_line,
     flicker_lines, EnfParams, FlickerLine, Grouping, PolaritySequence, SamplingMethod,
@@ -107,20 +107,20 @@ fn sample_reader(
         };
         sampler
             .push(batch)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            .map_err(|e| Error::from(e).context(path.display()))?;
         bar.inc(batch.len() as u64);
     }
     bar.finish_and_clear();
     let damage = reader.damage().cloned();
     if events == 0 {
         match damage {
-            Some(d) => bail!("{}", d.message),
-            None => bail!("{}: the event stream is empty", path.display()),
+            Some(d) => fail!(Method, "{}", d.message),
+            None => fail!(Method, "{}: the event stream is empty", path.display()),
         }
     }
     let seq = sampler
         .finish()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        .map_err(|e| Error::from(e).context(path.display()))?;
     let mut notes = info.notes.clone();
     notes.extend(mask.map(TileMask::describe));
     Ok(Sampled {
@@ -266,7 +266,11 @@ pub fn extract(rec: &Recording, opts: &ExtractOptions, progress: &Progress) -> R
     // when what was left before the damage is not enough, the error says why so little was read
     let damage = s.damage.as_ref().map(|d| d.message.clone());
     extract_sampled(path, s, opts, progress).map_err(|e| match damage {
-        Some(d) => anyhow::anyhow!("{e:#} (only the events before the damage were read: {d})"),
+        Some(d) => error!(
+            Method,
+            "{} (only the events before the damage were read: {d})",
+            e.report()
+        ),
         None => e,
     })
 }
@@ -351,7 +355,7 @@ pub fn extract_sampled(
     let top = 2.0 * grid * params.harmonics.max(1) as f64 + params.half_band_hz;
     let (x, fs) = flicker_signal(seq, top);
     let mut notes = s.notes;
-    let err = |e: eenf_dsp::DspError| anyhow::anyhow!("{}: {e}", path.display());
+    let err = |e: eenf_dsp::DspError| Error::from(e).context(path.display());
     let duration = seq.duration_s();
     if duration < params.window_s {
         if duration < MIN_WINDOW_S {

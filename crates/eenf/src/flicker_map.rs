@@ -1,7 +1,7 @@
 //! Where the flicker is: the mains line's strength in each tile of pixels, a picture in which a
 //! person sees the lamp and the surfaces it lights.
 
-use anyhow::{bail, Result};
+use crate::error::{fail, Result};
 use eenf_dsp::{flicker_lines, line_strength_at, FlickerLine};
 use eenf_events::OpenOptions;
 use rayon::prelude::*;
@@ -80,7 +80,8 @@ pub fn flicker_map_of(
 ) -> Result<FlickerMap> {
     let info = reader.info().clone();
     let (Some(width), Some(height)) = (info.width, info.height) else {
-        bail!(
+        fail!(
+            Method,
             "{}: the header gives no sensor size to lay tiles on",
             path.display()
         );

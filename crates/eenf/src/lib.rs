@@ -16,6 +16,8 @@
 //!   [`dataset`] and [`dataset_build`]: simulated recordings and datasets with their truth.
 //! - [`options`]: what each front end asks for, as option sets that check themselves.
 //!
+//! [`error`] says what went wrong, by area, for each front end to word.
+//!
 //! [`recording`] is what E-ENF reads (a file or events in memory); [`trace`] reads and writes
 //! traces, [`output`] writes every file whole or not at all, [`time`] holds all calendar and
 //! time-zone work.
@@ -28,6 +30,7 @@ pub mod bench;
 pub mod dataset;
 pub mod dataset_build;
 pub mod edits;
+pub mod error;
 pub mod evaluate;
 pub mod extract;
 pub mod flac_mask;
@@ -46,3 +49,5 @@ pub mod time;
 pub mod trace;
 pub mod video;
 pub mod wav;
+
+pub use error::{Area, Error, Result};

@@ -3,7 +3,7 @@
 use eenf_core::spelling::option;
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use crate::error::{fail, Context, Error, Result};
 use eenf_dsp::matching::{Candidate, MatchOptions, Score, Verification};
 use eenf_dsp::resample::resample;
 
@@ -128,7 +128,7 @@ pub fn locate_in(
         let res = r
             .values
             .search(&q, &opts)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", name.display()))?;
+            .map_err(|e| Error::from(e).context(name.display()))?;
         if let Some(v) = res.verification {
             verified = Some(Verified {
                 series: i,
@@ -159,10 +159,10 @@ pub fn locate_in(
 /// 50 or 60 Hz grid.
 pub fn match_grid(trace: &Trace, name: &Path) -> Result<f64> {
     if trace.enf_hz.len() < 2 {
-        bail!("{}: too short to match", name.display());
+        fail!(Input, "{}: too short to match", name.display());
     }
     if trace.step_s <= 0.0 {
-        bail!("{}: times must increase", name.display());
+        fail!(Input, "{}: times must increase", name.display());
     }
     trace.grid_or_err(name)
 }

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use crate::error::{error, fail, Error, Result};
 use eenf_dsp::hum::{MAX_HUM_HARMONIC, MIN_CLIP_S};
 use eenf_dsp::{
     check_holds_line, choose_window, enf_from_hum_lines, plausibility, reference_enf_with_snr,
@@ -17,11 +17,12 @@ use eenf_core::Signal;
 
 /// Decides or checks the nominal frequency of a mains signal: the line detector on f0 alone.
 pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<f64> {
-    let err = |e: eenf_dsp::DspError| anyhow::anyhow!("{}: {e}", path.display());
+    let err = |e: eenf_dsp::DspError| Error::from(e).context(path.display());
     let grids = grids_of(nominal);
     let top = grids.iter().fold(0.0f64, |a, &b| a.max(b));
     if sig.fs < 2.0 * (top + 8.0) {
-        bail!(
+        fail!(
+            Method,
             "{}: sample rate {} Hz is too low to carry a {top} Hz mains tone",
             path.display(),
             sig.fs
@@ -129,7 +130,7 @@ pub fn sound_trace(
     params: &EnfParams,
 ) -> Result<Trace> {
     let path = sound.name();
-    let err = |e: eenf_dsp::DspError| anyhow::anyhow!("{}: {e}", path.display());
+    let err = |e: eenf_dsp::DspError| Error::from(e).context(path.display());
     let grids = grids_of(nominal);
     let top_grid = grids.iter().fold(0.0f64, |a, &b| a.max(b));
     let most = match hum.lines {
@@ -184,7 +185,8 @@ pub fn sound_trace(
         }));
     }
     let search = search_hum(&a.signal.samples, a.signal.fs, 1.0, grids, most).ok_or_else(|| {
-        anyhow::anyhow!(
+        error!(
+            Method,
             "{}: sample rate {} Hz is too low to carry a mains line with its noise floor beside it",
             path.display(),
             a.signal.fs

@@ -10,7 +10,7 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use crate::error::{fail, Context, Result};
 use tempfile::NamedTempFile;
 
 pub use eenf_core::cleanup::{
@@ -83,7 +83,8 @@ impl AtomicFile {
             .into());
         }
         if path.as_os_str().to_string_lossy().ends_with('/') {
-            bail!(
+            fail!(
+                Output,
                 "{}: names a folder (it ends in /), not a file: give the file's name, e.g. {}out{}",
                 path.display(),
                 path.display(),

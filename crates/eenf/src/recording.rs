@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use anyhow::Result;
+use crate::error::Result;
 use eenf_events::{EventBatch, EventReader, OpenOptions};
 
 /// What E-ENF reads: an event file, or events already in memory (arrays from another

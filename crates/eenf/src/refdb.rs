@@ -16,7 +16,7 @@ use eenf_core::spelling::switch;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use crate::error::{fail, Context, Result};
 
 use crate::output::write_atomic;
 
@@ -77,7 +77,8 @@ impl StoreLock {
                 on_wait();
                 file.lock().with_context(|| format!("{}", path.display()))?;
             }
-            Err(std::fs::TryLockError::WouldBlock) => bail!(
+            Err(std::fs::TryLockError::WouldBlock) => fail!(
+                Store,
                 "{}: another build is changing this store (without {}, this one waits)",
                 dir.display(),
                 switch("no_wait")
@@ -123,7 +124,8 @@ pub fn check_grid_name(grid: &str) -> Result<()> {
             .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
         && !grid.starts_with('-');
     if !plain {
-        bail!(
+        fail!(
+            Store,
             "{grid:?} is not a grid name: letters, digits, _ and - only (at most 64), e.g. grid50"
         );
     }
@@ -192,7 +194,8 @@ impl StoredGrid {
             .with_context(|| format!("{}", json.display()))?
             .len();
         if size > 1 << 20 {
-            bail!(
+            fail!(
+                Store,
                 "{}: {size} bytes: not an eenf reference store manifest",
                 json.display()
             );
@@ -201,7 +204,8 @@ impl StoredGrid {
         let meta: RefMeta = serde_json::from_str(&text)
             .with_context(|| format!("{}: not an eenf reference store", json.display()))?;
         if meta.grid != grid {
-            bail!(
+            fail!(
+                Store,
                 "{}: names grid {:?}, but it is the manifest of {grid:?}: the store is damaged \
                  or was edited by hand",
                 json.display(),
@@ -209,7 +213,11 @@ impl StoredGrid {
             );
         }
         if !(meta.step_s.is_finite() && meta.step_s > 0.0 && meta.start_unix_s.is_finite()) {
-            bail!("{}: a damaged manifest (step or start)", json.display());
+            fail!(
+                Store,
+                "{}: a damaged manifest (step or start)",
+                json.display()
+            );
         }
         Ok(meta)
     }
@@ -221,7 +229,8 @@ impl StoredGrid {
             .clone()
             .unwrap_or_else(|| format!("{}.i32", meta.grid));
         if name.contains(['/', '\\']) || name.starts_with('.') {
-            bail!(
+            fail!(
+                Store,
                 "{}: names {name:?} as its values, not a file of the store",
                 manifest(dir, &meta.grid).display()
             );
@@ -237,7 +246,8 @@ impl StoredGrid {
             .with_context(|| format!("{}", data.display()))?
             .len();
         if len != meta.count as u64 * 4 || meta.count > MAX_VALUES {
-            bail!(
+            fail!(
+                Store,
                 "{}: {len} bytes where the manifest announces {} values: the store was damaged \
                  (a build interrupted before eenf committed its changes atomically); build this \
                  grid again from its sources",
@@ -249,7 +259,8 @@ impl StoredGrid {
         if let Some(want) = meta.values_crc32 {
             let got = crc_of(&bytes);
             if got != want {
-                bail!(
+                fail!(
+                    Store,
                     "{}: the values do not match their checksum (CRC-32 {got:08x}, the manifest \
                      says {want:08x}): they were damaged on disk; build this grid again from its \
                      sources",
@@ -357,7 +368,7 @@ impl StoredGrid {
         if first < 0 {
             let pad = (-first) as usize;
             if pad + self.values.len() > MAX_VALUES {
-                bail!("the series would span more than ten years");
+                fail!(Store, "the series would span more than ten years");
             }
             let mut v = vec![GAP; pad];
             v.extend_from_slice(&self.values);
@@ -367,7 +378,7 @@ impl StoredGrid {
         }
         let end = first as usize + vals.len();
         if end > MAX_VALUES {
-            bail!("the series would span more than ten years");
+            fail!(Store, "the series would span more than ten years");
         }
         if self.values.len() < end {
             self.values.resize(end, GAP);

@@ -5,7 +5,7 @@
 use eenf_core::spelling::{option, option_with};
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use crate::error::{fail, Error, Missing, Result};
 use eenf_dsp::matching::{match_trace, MatchError, MatchOptions, MatchResult, ScaledSeries};
 use eenf_dsp::{reference_enf, EnfParams};
 
@@ -83,7 +83,8 @@ pub fn reference_for_recording(
     let files = hourly_references(dir)?;
     let first = start.hour_index();
     let Some(pos) = files.iter().position(|(t, _)| t.hour_index() == first) else {
-        bail!(
+        fail!(
+            Reference,
             "{}: no reference for {} hour {:02} (expected a file like {}_Day_{:02}_00_00.wav)",
             dir.display(),
             start.date(),
@@ -107,7 +108,8 @@ pub fn reference_for_recording(
             fs = sig.fs;
             f0 = Some(mains_nominal(&sig, nominal, path)?);
         } else if sig.fs != fs {
-            bail!(
+            fail!(
+                Reference,
                 "{}: sample rate {} Hz differs from the previous hour's {fs} Hz",
                 path.display(),
                 sig.fs
@@ -118,10 +120,10 @@ pub fn reference_for_recording(
             break;
         }
     }
-    let f0 = f0.context("no reference loaded")?;
+    let f0 = f0.or_fail(Error::Reference, || "no reference loaded")?;
     let have_s = samples.len() as f64 / fs;
     if (from + seconds) as f64 > have_s + 1.0 {
-        bail!(
+        fail!(Reference,
             "{}: the references cover {:.0} s from {}_{:02}:00:00; the recording needs {} s from second {from}",
             dir.display(),
             have_s,
@@ -138,8 +140,7 @@ pub fn reference_for_recording(
         ..params.clone()
     };
     let slice = &samples[(a as f64 * fs) as usize..b];
-    let trace =
-        reference_enf(slice, fs, &p).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+    let trace = reference_enf(slice, fs, &p).map_err(|e| Error::from(e).context(dir.display()))?;
     let off = from - a;
     let out: Vec<f64> = (0..seconds)
         .map(|i| trace.get(off + i).copied().unwrap_or(f64::NAN))
@@ -152,14 +153,15 @@ pub fn reference_for_recording(
 /// clocks passed twice is read as its first passage (the name cannot tell), an hour they
 /// skipped is refused.
 pub fn wav_start(path: &Path, zone: Option<&Zone>) -> Result<f64> {
-    let t = crate::dataset::reference_hour(path).with_context(|| {
+    let t = crate::dataset::reference_hour(path).or_fail(Error::Input, || {
         format!(
             "{}: the name gives no start time (expected 2022_08_17_Wed_16_00_00.wav)",
             path.display()
         )
     })?;
     let Some(zone) = zone else {
-        bail!(
+        fail!(
+            Reference,
             "{}: its name gives a local time ({}-{:02}-{:02} {:02}:00) but not its zone: give the \
              zone with {} (e.g. {} or +08:00 where it was recorded in China, {} for UTC)",
             path.display(),
@@ -174,7 +176,8 @@ pub fn wav_start(path: &Path, zone: Option<&Zone>) -> Result<f64> {
     };
     match zone.instant(t.local_seconds()) {
         LocalInstant::Unique(u) | LocalInstant::Repeated(u, _) => Ok(u),
-        LocalInstant::Missing => bail!(
+        LocalInstant::Missing => fail!(
+            Reference,
             "{}: {}-{:02}-{:02} {:02}:00 does not exist in {} (the clocks skipped that hour)",
             path.display(),
             t.year(),
@@ -315,7 +318,11 @@ impl ReferenceSeries {
                     });
                 }
                 if out.is_empty() {
-                    bail!("{}: the store holds no {nominal} Hz grid", path.display());
+                    fail!(
+                        Reference,
+                        "{}: the store holds no {nominal} Hz grid",
+                        path.display()
+                    );
                 }
                 return Ok(out);
             }
@@ -332,7 +339,7 @@ impl ReferenceSeries {
             }
             bar.finish_and_clear();
             if series.values.is_empty() {
-                bail!("{}: no {nominal} Hz references", path.display());
+                fail!(Reference, "{}: no {nominal} Hz references", path.display());
             }
             return Ok(vec![ReferenceSeries {
                 name: path.display().to_string(),
@@ -464,7 +471,8 @@ pub fn build_store(
                     .into_iter()
                     .map(|(_, f)| (f, None, false)),
             ),
-            ReferenceSource::Store(dir) => bail!(
+            ReferenceSource::Store(dir) => fail!(
+                Reference,
                 "{}: a reference store; its series cannot be added to another store",
                 dir.display()
             ),
@@ -503,7 +511,7 @@ pub fn build_store(
             (pieces.collect(), nominal_hz)
         } else {
             let trace = read_series(path, build.index_step_s)?;
-            let start = at.or(next_start).with_context(|| {
+            let start = at.or(next_start).or_fail(Error::Input, || {
                 format!(
                     "{}: give its start as FILE@TIME or with {}",
                     path.display(),
@@ -538,7 +546,7 @@ pub fn build_store(
         };
         let s = &mut series[idx];
         if s.meta.nominal_hz != f0 {
-            bail!(
+            fail!(Reference,
                 "{}: a {f0} Hz trace cannot go into grid {grid:?}, which is {} Hz (50 and 60 Hz are never mixed)",
                 path.display(),
                 s.meta.nominal_hz
@@ -570,7 +578,8 @@ fn read_series(path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
     let text = crate::trace::read_text(path)?;
     let header = text.lines().next().unwrap_or("").to_ascii_lowercase();
     if index_step_s.is_none() && !header.contains("time_s") {
-        bail!(
+        fail!(
+            Reference,
             "{}: neither an eenf trace (time_s,enf_hz) nor a grid archive (dates or Unix times \
              and frequencies): an index,value CSV needs {} (seconds between values)",
             path.display(),
@@ -583,7 +592,7 @@ fn read_series(path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
 /// The grid of a trace's values, 50 or 60 Hz.
 fn nominal_of(trace: &Trace, path: &Path) -> Result<f64> {
     if trace.finite().next().is_none() {
-        bail!("{}: no values", path.display());
+        fail!(Reference, "{}: no values", path.display());
     }
     trace.grid_or_err(path)
 }

@@ -5,7 +5,7 @@
 use eenf_core::spelling::option;
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use crate::error::{error, fail, rule, Context, Error, Missing, Result};
 use eenf_events::writers::OutputFormat;
 use eenf_sim::{simulate, CameraConfig, MainsPhase, SimConfig, SimStats, SyntheticEnf};
 
@@ -68,13 +68,17 @@ impl EnfTimeline {
         let series = Trace::read(path, Some(step_s))?;
         let (step_s, values) = (series.step_s, series.enf_hz);
         if values.len() < 4 || values.iter().any(|v| !v.is_finite()) {
-            bail!("{}: a trace needs at least 4 finite values", path.display());
+            fail!(
+                Simulation,
+                "{}: a trace needs at least 4 finite values",
+                path.display()
+            );
         }
         let mean = values.iter().sum::<f64>() / values.len() as f64;
         let nominal_hz = [50.0, 60.0]
             .into_iter()
             .find(|f| (mean - f).abs() < 1.0)
-            .with_context(|| {
+            .or_fail(Error::Input, || {
                 format!(
                     "{}: mean {mean:.3} Hz is neither a 50 nor a 60 Hz grid",
                     path.display()
@@ -159,7 +163,8 @@ impl EnfTimeline {
             } => {
                 let (from, to) = self.coverage()?;
                 if start < from || start + duration_s > to {
-                    bail!(
+                    fail!(
+                        Simulation,
                         "the ENF trace covers {:.0} s; {:.0} s from second {:.0} do not fit",
                         to - from,
                         duration_s,
@@ -191,12 +196,20 @@ impl EnfTimeline {
                     }
                     let sig = read_wav(p)?;
                     if fs != 0.0 && sig.fs != fs {
-                        bail!("{}: its rate differs from the previous file's", p.display());
+                        fail!(
+                            Simulation,
+                            "{}: its rate differs from the previous file's",
+                            p.display()
+                        );
                     }
                     if let Some(ft) = first_t {
                         let expected = ft + samples.len() as f64 / fs;
                         if (t - expected).abs() > 1.0 {
-                            bail!("{}: there is a gap before this file", p.display());
+                            fail!(
+                                Simulation,
+                                "{}: there is a gap before this file",
+                                p.display()
+                            );
                         }
                     } else {
                         first_t = Some(*t);
@@ -205,10 +218,13 @@ impl EnfTimeline {
                     samples.extend_from_slice(&sig.samples);
                 }
                 let Some(ft) = first_t else {
-                    bail!("no mains recording covers local time {start:.0} s");
+                    fail!(
+                        Simulation,
+                        "no mains recording covers local time {start:.0} s"
+                    );
                 };
                 MainsPhase::from_recording(&samples, fs, *nominal_hz, start - ft, duration_s)
-                    .map_err(|e| anyhow::anyhow!("{}: {e}", files[0].1.display()))
+                    .map_err(|e| error!(Simulation, "{}: {e}", files[0].1.display()))
             }
         }
     }
@@ -240,7 +256,8 @@ impl EnfTimeline {
                 let (have_from, have_to) = self.coverage()?;
                 let mut hour = (from / 3600.0).floor() * 3600.0;
                 if hour < have_from || (to / 3600.0).ceil() * 3600.0 > have_to {
-                    bail!(
+                    fail!(
+                        Simulation,
                         "hourly references need the ENF of whole hours; the trace covers {:.0} s",
                         have_to - have_from
                     );
@@ -261,7 +278,9 @@ impl EnfTimeline {
             EnfTimeline::Mains { files, .. } => {
                 // all of them: they are the dataset's references
                 for (_, p) in files {
-                    let name = p.file_name().context("a reference without a file name")?;
+                    let name = p
+                        .file_name()
+                        .or_fail(Error::Simulation, || "a reference without a file name")?;
                     let dest = dir.join(name);
                     if dest != *p {
                         let tmp = dest.with_extension("wav.tmp");
@@ -313,7 +332,7 @@ pub fn write_recording(
 ) -> Result<Simulated> {
     config
         .check()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", output.display()))?;
+        .map_err(|e| error!(Simulation, "{}: {e}", output.display()))?;
     let started = std::time::Instant::now();
     let step_us = config.readout.step_us();
     let bar = progress.steps(
@@ -327,11 +346,11 @@ pub fn write_recording(
     write_events(output, format, config.width, config.height, |writer| {
         stats = Some(simulate(config, mains, |b| {
             bar.inc(250);
-            writer.write(b).map_err(anyhow::Error::from)
+            writer.write(b).map_err(Error::from)
         })?);
         Ok(())
     })?;
-    let stats = stats.context("the simulation gave no statistics")?;
+    let stats = stats.or_fail(Error::Simulation, || "the simulation gave no statistics")?;
     bar.finish_and_clear();
     let truth = Trace::new(1.0, mains.truth(config.duration_s));
     let truth_path = sibling(output, "truth.csv");
@@ -362,7 +381,7 @@ pub fn write_recording(
 
 /// Parses `lr,hr` into camera presets, scaled by `scale` (0 < scale ≤ 1); `hr@0.125` gives a
 /// camera its own scale.
-pub fn parse_cameras(list: &str, scale: f64) -> anyhow::Result<Vec<eenf_sim::CameraConfig>> {
+pub fn parse_cameras(list: &str, scale: f64) -> Result<Vec<eenf_sim::CameraConfig>> {
     list.split(',')
         .filter(|s| !s.trim().is_empty())
         .map(|item| {
@@ -370,17 +389,28 @@ pub fn parse_cameras(list: &str, scale: f64) -> anyhow::Result<Vec<eenf_sim::Cam
                 Some((n, f)) => (
                     n,
                     f.parse::<f64>().map_err(|_| {
-                        anyhow::anyhow!("{} {item:?}: bad scale {f:?}", option("video"))
+                        rule(
+                            "video",
+                            format!("{} {item:?}: bad scale {f:?}", option("video")),
+                        )
                     })?,
                 ),
                 None => (item.trim(), scale),
             };
             if !(own > 0.0 && own <= 1.0) {
-                anyhow::bail!("{} must lie in (0, 1], not {own}", option("video_scale"));
+                return Err(rule(
+                    "video_scale",
+                    format!("{} must lie in (0, 1], not {own}", option("video_scale")),
+                ));
             }
             eenf_sim::CameraConfig::named(name)
                 .map(|c| c.scaled(own))
-                .ok_or_else(|| anyhow::anyhow!("{} {name:?}: expected lr or hr", option("video")))
+                .ok_or_else(|| {
+                    rule(
+                        "video",
+                        format!("{} {name:?}: expected lr or hr", option("video")),
+                    )
+                })
         })
         .collect()
 }
@@ -395,10 +425,10 @@ pub fn write_video(
     output: &Path,
     mp4: bool,
     progress: &Progress,
-) -> anyhow::Result<VideoFiles> {
+) -> Result<VideoFiles> {
     camera
         .check()
-        .map_err(|e| anyhow::anyhow!("camera {}: {e}", camera.name))?;
+        .map_err(|e| error!(Simulation, "camera {}: {e}", camera.name))?;
     let stem = output.file_stem().unwrap_or_default().to_string_lossy();
     let y4m = output.with_file_name(format!("{stem}_{}.y4m", camera.name));
     let frames = (config.duration_s * camera.fps).floor() as u64;
@@ -430,7 +460,7 @@ pub fn write_video(
             .status();
         match status {
             Ok(s) if s.success() => written.push(mp4_path),
-            Ok(s) => anyhow::bail!("{}: ffmpeg failed ({s})", mp4_path.display()),
+            Ok(s) => fail!(Simulation, "{}: ffmpeg failed ({s})", mp4_path.display()),
             Err(e) => note = Some(format!("no MP4 ({tool}: {e}); the Y4M is written")),
         }
     }
@@ -540,7 +570,7 @@ pub fn recipe_timeline(r: &Recipe) -> Result<(EnfTimeline, f64, f64)> {
     match &r.enf {
         EnfSource::Synthetic(grid) => {
             if *grid != 50.0 && *grid != 60.0 {
-                bail!("{} must be 50 or 60", option("grid"));
+                return Err(rule("grid", format!("{} must be 50 or 60", option("grid"))));
             }
             let (start, tz) = local_start(&r.start, None, 0.0)?;
             let seed = r.config.seed ^ 0x5eed;
@@ -553,14 +583,14 @@ pub fn recipe_timeline(r: &Recipe) -> Result<(EnfTimeline, f64, f64)> {
             index_step_s,
         } => {
             if !path.exists() {
-                bail!("{}: no such file", path.display());
+                fail!(Simulation, "{}: no such file", path.display());
             }
             let (start, tz) = local_start(&r.start, Some(path), *offset_s)?;
             let t0 = start - offset_s;
             let t = match ReferenceSource::open(path)? {
                 ReferenceSource::Wav(_) => EnfTimeline::wav(path, t0)?,
                 ReferenceSource::Trace(_) => EnfTimeline::trace(path, *index_step_s, t0)?,
-                _ => bail!(
+                _ => fail!(Simulation,
                     "{}: a mains WAV or a trace file is needed here (not a folder or a grid archive)",
                     path.display()
                 ),
@@ -577,7 +607,7 @@ pub fn simulate_recording(r: &Recipe, progress: &Progress) -> Result<SimulatedRe
         start_us: ((start - tz) * 1e6).round() as i64,
         ..r.config.clone()
     };
-    config.check().map_err(|e| anyhow::anyhow!("{e}"))?;
+    config.check().map_err(|e| error!(Simulation, "{e}"))?;
     let mains = timeline.phase(start, config.duration_s)?;
     let extra = serde_json::json!({
         "enf": timeline.describe(),

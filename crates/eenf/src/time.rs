@@ -3,7 +3,7 @@
 //! archives carry. Calendar arithmetic and the time zone database are jiff's (the system's
 //! zoneinfo, or the copy built in where a machine has none).
 
-use anyhow::{bail, Context, Result};
+use crate::error::{error, fail, Context, Error, Result};
 use jiff::civil::{DateTime, Weekday};
 use jiff::tz::{AmbiguousOffset, Offset, TimeZone};
 use jiff::Timestamp;
@@ -128,7 +128,7 @@ impl Zone {
     pub fn fixed(seconds: f64) -> Result<Self> {
         let s = seconds.round();
         if s.is_nan() || s.abs() > 18.0 * 3600.0 {
-            bail!("{seconds} s: not a UTC offset (at most 18 hours)");
+            fail!(Input, "{seconds} s: not a UTC offset (at most 18 hours)");
         }
         Ok(Zone(TimeZone::fixed(Offset::from_seconds(s as i32)?)))
     }
@@ -145,7 +145,8 @@ impl Zone {
         }
         match TimeZone::get(s) {
             Ok(tz) => Ok(Zone(tz)),
-            Err(_) => bail!(
+            Err(_) => fail!(
+                Input,
                 "{s:?}: not a time zone: give an IANA name (Europe/Berlin, America/New_York, \
                  Asia/Shanghai), an offset (+08:00) or Z for UTC"
             ),
@@ -199,7 +200,7 @@ impl Zone {
 }
 
 impl std::str::FromStr for Zone {
-    type Err = anyhow::Error;
+    type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
         Zone::parse(s)
     }
@@ -253,7 +254,8 @@ pub fn parse_time(s: &str) -> Result<f64> {
     }
     let s = s.trim();
     let bad = || {
-        anyhow::anyhow!(
+        error!(
+            Input,
             "{s:?}: expected a time like 2022-08-17T16:10:00Z or 2022-08-17T16:10:00+08:00"
         )
     };
@@ -261,7 +263,10 @@ pub fn parse_time(s: &str) -> Result<f64> {
         Ok(ts) => ts,
         Err(_) => {
             if s.parse::<DateTime>().is_ok() {
-                bail!("{s:?} names no time zone: add Z for UTC or the offset, e.g. {s}+08:00");
+                fail!(
+                    Input,
+                    "{s:?} names no time zone: add Z for UTC or the offset, e.g. {s}+08:00"
+                );
             }
             return Err(bad());
         }
@@ -277,16 +282,16 @@ pub fn tz_offset(tz: &str) -> Result<f64> {
     let sign = match tz.as_bytes()[0] {
         b'+' => 1.0,
         b'-' => -1.0,
-        _ => bail!("{tz:?}: expected a UTC offset like +08:00"),
+        _ => fail!(Input, "{tz:?}: expected a UTC offset like +08:00"),
     };
     let digits: String = tz[1..].chars().filter(|c| c.is_ascii_digit()).collect();
     let (h, m) = match digits.len() {
         1 | 2 => (digits.parse::<f64>()?, 0.0),
         4 => (digits[..2].parse::<f64>()?, digits[2..].parse::<f64>()?),
-        _ => bail!("{tz:?}: expected a UTC offset like +08:00"),
+        _ => fail!(Input, "{tz:?}: expected a UTC offset like +08:00"),
     };
     if h > 18.0 || m >= 60.0 {
-        bail!("{tz:?}: expected a UTC offset like +08:00");
+        fail!(Input, "{tz:?}: expected a UTC offset like +08:00");
     }
     Ok(sign * (h * 3600.0 + m * 60.0))
 }

@@ -5,7 +5,7 @@
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use crate::error::{error, fail, Context, Error, Missing, Result};
 use eenf_dsp::{
     EnfEstimates, EnfParams, FlickerLine, HumSearch, PeakMethod, Plausibility, SamplingMethod,
 };
@@ -447,7 +447,8 @@ impl Trace {
     /// [`Trace::grid_hz`], or an error naming the trace `name` and its mean.
     pub fn grid_or_err(&self, name: &Path) -> Result<f64> {
         self.grid_hz().ok_or_else(|| {
-            anyhow::anyhow!(
+            error!(
+                Input,
                 "{}: mean {:.3} Hz is neither a 50 nor a 60 Hz grid",
                 name.display(),
                 self.mean_hz()
@@ -542,7 +543,7 @@ impl Trace {
     fn check(&self, path: &Path) -> Result<()> {
         let name = path.display();
         if !(self.step_s.is_finite() && (MIN_STEP_S..=MAX_STEP_S).contains(&self.step_s)) {
-            bail!(
+            fail!(Input,
                 "{name}: its estimates are {} s apart; an ENF trace steps by {MIN_STEP_S} s to {MAX_STEP_S} s",
                 self.step_s
             );
@@ -552,7 +553,7 @@ impl Trace {
             .windows(2)
             .position(|w| !(w[1] - w[0] >= MIN_STEP_S && w[1].is_finite()))
         {
-            bail!(
+            fail!(Input,
                 "{name}: time_s goes from {} to {} at estimate {}: times must rise by {MIN_STEP_S} s or more",
                 self.time_s[i],
                 self.time_s[i + 1],
@@ -560,7 +561,8 @@ impl Trace {
             );
         }
         if let Some(i) = self.enf_hz.iter().position(|v| v.abs() > MAX_VALUE) {
-            bail!(
+            fail!(
+                Input,
                 "{name}: estimate {} is {:e}, beyond any frequency (or deviation) of a grid",
                 i,
                 self.enf_hz[i]
@@ -588,13 +590,18 @@ impl Trace {
         let v: serde_json::Value = serde_json::from_str(text)
             .with_context(|| format!("{}: not valid JSON", path.display()))?;
         let core: TraceJson = serde_json::from_value(v.clone()).map_err(|e| {
-            anyhow::anyhow!(
+            error!(
+                Input,
                 "{}: not an eenf trace (time_s and enf_hz arrays): {e}",
                 path.display()
             )
         })?;
         if core.time_s.len() != core.enf_hz.len() {
-            bail!("{}: time_s and enf_hz differ in length", path.display());
+            fail!(
+                Input,
+                "{}: time_s and enf_hz differ in length",
+                path.display()
+            );
         }
         Ok(Trace {
             step_s: core.step_s.unwrap_or_else(|| step_of(&core.time_s)),
@@ -623,7 +630,8 @@ impl Trace {
         let headers = reader.headers().cloned().unwrap_or_default();
         let col = |name: &str| headers.iter().position(|h| h == name);
         let (Some(ti), Some(fi)) = (col("time_s"), col("enf_hz")) else {
-            bail!(
+            fail!(
+                Input,
                 "{}: not a trace file (expected a CSV with header {CSV_HEADER:?} or eenf JSON)",
                 path.display()
             );
@@ -657,7 +665,7 @@ impl Trace {
             }
         }
         if trace.time_s.is_empty() {
-            bail!("{}: the trace is empty", path.display());
+            fail!(Input, "{}: the trace is empty", path.display());
         }
         trace.step_s = step_of(&trace.time_s);
         Ok(trace)
@@ -680,7 +688,7 @@ impl Trace {
                 .split(',')
                 .nth(1)
                 .and_then(|v| v.trim().parse::<f64>().ok())
-                .with_context(|| {
+                .or_fail(Error::Input, || {
                     format!("{}: line {}: expected index,value", path.display(), i + 1)
                 })?;
             values.push(v);
@@ -721,21 +729,24 @@ pub fn read_text(path: &Path) -> Result<String> {
             break;
         }
         if n as u64 > MAX_LINE && text.last() != Some(&b'\n') {
-            bail!(
+            fail!(
+                Input,
                 "{}: line {line_no} is longer than {} KiB: not a trace file",
                 path.display(),
                 MAX_LINE >> 10
             );
         }
         if text[start..].contains(&0) {
-            bail!(
+            fail!(
+                Input,
                 "{}: line {line_no} holds binary data: not a trace file",
                 path.display()
             );
         }
     }
     String::from_utf8(text).map_err(|e| {
-        anyhow::anyhow!(
+        error!(
+            Input,
             "{}: not text (invalid UTF-8 at byte {}): not a trace file",
             path.display(),
             e.utf8_error().valid_up_to()

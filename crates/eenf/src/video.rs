@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use crate::error::Result;
 use eenf_video::{video_enf, FrameSource, VideoOptions};
 
 use crate::progress::Progress;

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use crate::error::Result;
 
 /// Writes a mono 16-bit WAV (samples in ±1), whole or not at all.
 pub fn write_wav(path: &Path, fs: u32, samples: &[f64]) -> Result<()> {

@@ -89,5 +89,5 @@ fn samples_in_memory_give_the_wav_trace_and_nan_is_refused() {
     assert!(same(&got.enf_hz, &want.enf_hz));
     pcm[777] = f32::NAN;
     let e = in_memory(&pcm).unwrap_err();
-    assert!(format!("{e:#}").contains("sample 777"), "{e:#}");
+    assert!(e.report().contains("sample 777"), "{}", e.report());
 }

@@ -37,7 +37,7 @@ fn not_white(rgb: &[u8]) -> usize {
 
 /// Draws with `draw` as PNG and SVG into a fresh folder; checks what every figure must be and
 /// returns the PNG's pixels and the SVG's text.
-fn both(name: &str, title: &str, draw: impl Fn(&Path) -> anyhow::Result<()>) -> (Vec<u8>, String) {
+fn both(name: &str, title: &str, draw: impl Fn(&Path) -> eenf::Result<()>) -> (Vec<u8>, String) {
     let dir = tempfile::tempdir().unwrap();
     let png_path = dir.path().join(format!("{name}.png"));
     let svg_path = dir.path().join(format!("{name}.svg"));
@@ -99,7 +99,7 @@ fn a_comparison_draws_the_estimate_and_refuses_other_formats() {
     std::fs::write(&file, "x").unwrap();
     for bad in [dir.path().join("x.jpg"), file.join("x.png")] {
         let err = plot_comparison(&bad, "t", &t, &estimate, &reference).unwrap_err();
-        assert!(format!("{err:#}").contains("x."), "{err:#}");
+        assert!(err.report().contains("x."), "{}", err.report());
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     // a folder that does not exist yet is made

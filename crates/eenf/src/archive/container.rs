@@ -5,7 +5,7 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use crate::error::{error, fail, Context, Error, Result};
 
 use super::MAX_LINE;
 
@@ -46,7 +46,7 @@ pub(super) fn for_each_member(path: &Path, each: &mut MemberFn<'_>) -> Result<Ve
     let name = path.display();
     let open = || File::open(path).with_context(|| format!("{name}"));
     if path.is_dir() {
-        bail!("{name}: a folder, not a grid archive");
+        fail!(Archive, "{name}: a folder, not a grid archive");
     }
     let mut head = [0u8; 6];
     let n = open()?.read(&mut head).with_context(|| format!("{name}"))?;
@@ -81,7 +81,10 @@ pub(super) fn for_each_member(path: &Path, each: &mut MemberFn<'_>) -> Result<Ve
             }
             let tables: Vec<String> = names.iter().filter(|n| is_table(n)).cloned().collect();
             if tables.is_empty() {
-                bail!("{name}: a zip archive with no CSV or text table in it");
+                fail!(
+                    Archive,
+                    "{name}: a zip archive with no CSV or text table in it"
+                );
             }
             for m in &tables {
                 let entry = match zip.by_name(m) {
@@ -101,8 +104,8 @@ pub(super) fn for_each_member(path: &Path, each: &mut MemberFn<'_>) -> Result<Ve
                 BufReader::new(open()?),
                 sevenz_rust2::Password::empty(),
             )
-            .map_err(|e| anyhow::anyhow!("{name}: not a readable 7z archive: {e}"))?;
-            let mut failure: Option<anyhow::Error> = None;
+            .map_err(|e| error!(Archive, "{name}: not a readable 7z archive: {e}"))?;
+            let mut failure: Option<Error> = None;
             let mut tables = 0usize;
             let walked = reader.for_each_entries(|entry, r| {
                 if entry.is_directory || !is_table(&entry.name) {
@@ -126,7 +129,10 @@ pub(super) fn for_each_member(path: &Path, each: &mut MemberFn<'_>) -> Result<Ve
                 ));
             }
             if tables == 0 {
-                bail!("{name}: a 7z archive with no CSV or text table in it");
+                fail!(
+                    Archive,
+                    "{name}: a 7z archive with no CSV or text table in it"
+                );
             }
         }
     }
@@ -165,7 +171,10 @@ pub(super) fn zip_in_order(
         }
     }
     if tables == 0 {
-        bail!("{name}: not a readable zip archive ({why}), and no whole table at its start");
+        fail!(
+            Archive,
+            "{name}: not a readable zip archive ({why}), and no whole table at its start"
+        );
     }
     Ok(warnings)
 }
@@ -187,7 +196,11 @@ pub(super) fn read_line(r: &mut dyn BufRead, buf: &mut Vec<u8>) -> Result<usize>
         r.consume(take);
         total += take;
         if buf.len() > MAX_LINE {
-            bail!("a line longer than {} KiB: not a table", MAX_LINE >> 10);
+            fail!(
+                Archive,
+                "a line longer than {} KiB: not a table",
+                MAX_LINE >> 10
+            );
         }
         if done {
             while buf.last().is_some_and(|&b| b == b'\n' || b == b'\r') {
@@ -212,7 +225,7 @@ pub(super) fn first_lines(r: &mut dyn BufRead, n: usize) -> Result<Vec<String>> 
             buf.drain(..3);
         }
         if buf.starts_with(b"\xFF\xFE") || buf.starts_with(b"\xFE\xFF") {
-            bail!("UTF-16 text: save it as UTF-8");
+            fail!(Archive, "UTF-16 text: save it as UTF-8");
         }
         let line = String::from_utf8_lossy(&buf).into_owned();
         let t = line.trim();

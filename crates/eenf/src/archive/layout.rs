@@ -4,7 +4,7 @@
 use eenf_core::spelling::{option, option_with};
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use crate::error::{fail, Error, Missing, Result};
 
 use super::dates::{civil_seconds, parse_clock, parse_date, parse_date_time, DateShape};
 use super::{ArchiveFormat, ArchiveOptions, DateOrder, ValueUnit, MAX_STEP_S, YEARS};
@@ -170,10 +170,10 @@ impl Layout {
                 } else if (55.0..65.0).contains(&m) {
                     Ok(60.0)
                 } else {
-                    bail!("{label}: its values (median {m}) are not near 50 or 60 Hz")
+                    fail!(Archive, "{label}: its values (median {m}) are not near 50 or 60 Hz")
                 }
             }
-            _ => bail!(
+            _ => fail!(Archive,
                 "{label}: its values are deviations from the nominal frequency: give it with {} or {}",
                 option_with("nominal", "50"),
                 option_with("nominal", "60")
@@ -272,7 +272,7 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
                 .take(8)
                 .all(|l| l.as_bytes().split(|&b| b == d).count() >= 2)
         })
-        .with_context(|| {
+        .or_fail(Error::Archive, || {
             format!("{name}: not a table of times and frequencies: its first line {shown:?} has no ; , or tab between columns")
         })?;
     let decimal_comma = delimiter != b',';
@@ -290,7 +290,7 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
     let first_data = usize::from(is_header);
     let rows: Vec<Vec<Vec<u8>>> = lines[first_data..].iter().map(|l| fields_of(l)).collect();
     let Some(row0) = rows.first() else {
-        bail!("{name}: a header ({shown:?}) and no rows");
+        fail!(Archive, "{name}: a header ({shown:?}) and no rows");
     };
     let ncols = row0.len();
     // a sampled field of the first row, for messages
@@ -351,7 +351,7 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
             !y.is_empty() && y.iter().all(|v| YEARS.contains(&(*v as i64)))
         };
         if !ok {
-            bail!("{name}: not the osf layout (expected year;month;day;hour;minute;second;value rows without a header), first line {shown:?}");
+            fail!(Archive, "{name}: not the osf layout (expected year;month;day;hour;minute;second;value rows without a header), first line {shown:?}");
         }
         TimeColumns::Fields(0)
     } else if let Some(c) = kinds.iter().position(|k| *k == FieldKind::DateTime) {
@@ -384,7 +384,10 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
     }) {
         TimeColumns::Unix(c, scale)
     } else {
-        bail!("{name}: no time column: expected {expected}; first line {shown:?}");
+        fail!(
+            Archive,
+            "{name}: no time column: expected {expected}; first line {shown:?}"
+        );
     };
     let time_cols: Vec<usize> = match time {
         TimeColumns::DateTime(c) | TimeColumns::Unix(c, _) => vec![c],
@@ -418,7 +421,7 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
         .find(|&c| near_grid(c))
         .or_else(|| candidates.iter().copied().find(|&c| looks_named(&names[c])))
         .or_else(|| (candidates.len() == 1).then(|| candidates[0]))
-        .with_context(|| {
+        .or_fail(Error::Archive, || {
             format!("{name}: no column of frequencies beside the time (expected values near 50 or 60 Hz, or a deviation the header names); first line {shown:?}")
         })?;
     let unit = match opts.unit {
@@ -434,7 +437,7 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
             {
                 ValueUnit::HzDeviation
             } else {
-                bail!(
+                fail!(Archive,
                     "{name}: column {} ({:?}) is not near 50 or 60 Hz and its header does not say it is a deviation: give {} hz, mhz-deviation or hz-deviation",
                     value + 1,
                     names[value],
@@ -477,7 +480,7 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
             } else if sep_dot {
                 DateOrder::Dmy // 17.08.2022: the dotted style is day first wherever it is used
             } else {
-                bail!(
+                fail!(Archive,
                     "{name}: dates such as {:?} can be read day/month or month/day: give {} dmy or mdy",
                     String::from_utf8_lossy(field(c)),
                     option("date_order")
@@ -511,7 +514,8 @@ pub fn sniff(lines: &[String], opts: &ArchiveOptions, path: &Path) -> Result<Lay
     } else if let Some(why) = format.zone() {
         ZoneRule::Utc(why)
     } else {
-        bail!(
+        fail!(
+            Archive,
             "{name}: its times ({:?}) carry no zone and none is assumed: give it with {} ({})",
             String::from_utf8_lossy(field(date_col.unwrap_or(0))),
             option("tz"),

@@ -24,7 +24,7 @@ use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use crate::error::{fail, Result};
 use eenf_dsp::resample::Steps;
 
 use crate::time::Zone;
@@ -455,10 +455,11 @@ pub fn import(path: &Path, opts: &ArchiveOptions, step_s: Option<f64>) -> Result
     })?;
     report.warnings.extend(warnings);
     let Some(st) = state else {
-        bail!("{name}: holds no frequency rows");
+        fail!(Archive, "{name}: holds no frequency rows");
     };
     if report.used == 0 {
-        bail!(
+        fail!(
+            Archive,
             "{name}: none of its {} rows holds a plausible frequency{}",
             report.rows,
             report

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use crate::error::{fail, Context, Error, Missing, Result};
 use serde::Serialize;
 
 /// One recording of a dataset to score: its event file, class, reference and videos.
@@ -38,7 +38,8 @@ pub const PROMINENCE_BANDS: [(f64, &str); 4] = [
 pub fn group_by_prominence(recs: &mut [DatasetEntry]) -> Result<()> {
     for r in recs.iter_mut() {
         let Some(p) = r.prominence else {
-            bail!(
+            fail!(
+                Input,
                 "{}: the manifest gives no prominence (simulate-dataset writes one)",
                 r.path.display()
             );
@@ -106,7 +107,11 @@ pub fn discover(dataset: &Path) -> Result<Vec<DatasetEntry>> {
     } else if dataset.is_file() {
         read_manifest(dataset)
     } else {
-        bail!("{}: no such dataset folder or manifest", dataset.display())
+        fail!(
+            Input,
+            "{}: no such dataset folder or manifest",
+            dataset.display()
+        )
     }
 }
 
@@ -134,7 +139,7 @@ fn is_hidden(p: &Path) -> bool {
 fn scan_tree(dir: &Path) -> Result<Vec<DatasetEntry>> {
     let references = dir.join("ENF_Reference");
     if !references.is_dir() {
-        bail!(
+        fail!(Input,
             "{}: no ENF_Reference folder (an EV-ENFD-like tree has one folder per class and ENF_Reference/ with the hourly WAVs; or pass a manifest CSV)",
             dir.display()
         );
@@ -183,7 +188,8 @@ fn scan_tree(dir: &Path) -> Result<Vec<DatasetEntry>> {
         }
     }
     if out.is_empty() {
-        bail!(
+        fail!(
+            Input,
             "{}: no event recordings ({}) in its class folders",
             dir.display(),
             EVENT_EXTENSIONS.join(", ")
@@ -214,7 +220,7 @@ pub fn read_manifest(path: &Path) -> Result<Vec<DatasetEntry>> {
     let (Some(rec_c), Some(class_c), Some(ref_c)) =
         (col("recording"), col("class"), col("reference"))
     else {
-        bail!(
+        fail!(Input,
             "{}: a manifest needs the columns recording, class, reference (and optionally offset_s, videos); found {:?}",
             path.display(),
             headers.iter().collect::<Vec<_>>()
@@ -230,7 +236,7 @@ pub fn read_manifest(path: &Path) -> Result<Vec<DatasetEntry>> {
         let field = |c: Option<usize>| c.map(get).unwrap_or_default();
         let recording = get(rec_c);
         if recording.is_empty() {
-            bail!("{}: line {line}: empty recording", path.display());
+            fail!(Input, "{}: line {line}: empty recording", path.display());
         }
         let offset_s = match field(off_c).as_str() {
             "" => 0.0,
@@ -238,7 +244,7 @@ pub fn read_manifest(path: &Path) -> Result<Vec<DatasetEntry>> {
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .with_context(|| {
+                .or_fail(Error::Input, || {
                     format!(
                         "{}: line {line}: offset_s {s:?} is not a number",
                         path.display()
@@ -265,7 +271,11 @@ pub fn read_manifest(path: &Path) -> Result<Vec<DatasetEntry>> {
         });
     }
     if out.is_empty() {
-        bail!("{}: the manifest lists no recordings", path.display());
+        fail!(
+            Input,
+            "{}: the manifest lists no recordings",
+            path.display()
+        );
     }
     Ok(out)
 }

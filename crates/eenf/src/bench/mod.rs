@@ -8,7 +8,7 @@ pub mod report;
 pub mod run;
 pub mod settings;
 
-use anyhow::{bail, Result};
+use crate::error::{rule, Result};
 use eenf_core::spelling::option;
 use serde::Serialize;
 
@@ -57,13 +57,16 @@ impl Method {
         for name in s.split(',').map(str::trim).filter(|n| !n.is_empty()) {
             let m: Method = name
                 .parse()
-                .map_err(|e| anyhow::anyhow!("{}: {e}", option("methods")))?;
+                .map_err(|e| rule("methods", format!("{}: {e}", option("methods"))))?;
             if !out.contains(&m) {
                 out.push(m);
             }
         }
         if out.is_empty() {
-            bail!("{}: no method given", option("methods"));
+            return Err(rule(
+                "methods",
+                format!("{}: no method given", option("methods")),
+            ));
         }
         out.sort_by_key(|m| Method::ALL.iter().position(|a| a == m));
         Ok(out)

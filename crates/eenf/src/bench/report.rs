@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use crate::error::{Context, Result};
 use eenf_dsp::Agreement;
 
 use super::{paper_value, DatasetEntry, Method, Run};

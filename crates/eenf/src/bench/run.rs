@@ -1,6 +1,6 @@
 //! Running methods on recordings: trace, score against the reference, summarise per class.
 
-use anyhow::{bail, Context, Result};
+use crate::error::{fail, Context, Error, Missing, Result};
 use eenf_dsp::{spectrogram, Agreement, Spectrogram};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -61,7 +61,7 @@ pub fn evaluate(
         Err(e) => Outcome {
             recording: index,
             method,
-            result: Err(format!("{e:#}")),
+            result: Err(e.report()),
             run_s,
             details: None,
         },
@@ -100,7 +100,7 @@ fn trace_events(
 
 /// V-ENF on the recording's video from `camera`.
 fn trace_video(rec: &DatasetEntry, camera: &str, s: &Settings) -> Result<Trace> {
-    let path = rec.video(camera).with_context(|| {
+    let path = rec.video(camera).or_fail(Error::Input, || {
         format!(
             "{}: no {camera} video beside it (<stem>_{camera}.y4m/.mp4/…)",
             rec.path.display()
@@ -139,7 +139,7 @@ fn run_method(rec: &DatasetEntry, method: Method, s: &Settings, spectrum: bool) 
     let traced_on = t.nominal_hz.unwrap_or(f64::NAN);
     if let Some(f0) = comparison.nominal_hz {
         if f0 != traced_on {
-            bail!(
+            fail!(Method,
                 "{}: traced on a {traced_on} Hz grid, but the reference is on {f0} Hz (the flicker found is not the mains')",
                 source.display(),
             );

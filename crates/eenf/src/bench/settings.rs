@@ -1,6 +1,6 @@
 //! The settings of a benchmark run, and `--sweep key=v1,v2,…` ablations over them.
 
-use anyhow::{bail, Context, Result};
+use crate::error::{rule, Error, Missing, Result};
 use eenf_core::spelling::option;
 use eenf_video::VideoOptions;
 
@@ -33,7 +33,12 @@ impl Settings {
 
     /// Sets `key` to `value` (enum values parsed as the command line parses them).
     fn set(&mut self, key: &str, value: &str) -> Result<()> {
-        let bad = || anyhow::anyhow!("{} {key}={value}: not a valid value", option("sweep"));
+        let bad = || {
+            rule(
+                "sweep",
+                format!("{} {key}={value}: not a valid value", option("sweep")),
+            )
+        };
         let p = &mut self.extract.params;
         match key {
             "harmonics" => p.harmonics = value.parse().ok().filter(|h| *h >= 1).ok_or_else(bad)?,
@@ -71,10 +76,7 @@ impl Settings {
             "median-len" => p.median_len = value.parse().map_err(|_| bad())?,
             "scene-removal" => self.video.scene_removal = value.parse().map_err(|_| bad())?,
             "video-sampling" => self.video.sampling = value.parse().map_err(|_| bad())?,
-            _ => bail!(
-                "{} {key}: unknown setting (harmonics, sampling, peak, window, dt-us, selection, tiles, segment, median-len, scene-removal, video-sampling)",
-                option("sweep")
-            ),
+            _ => return Err(rule("sweep", format!("{} {key}: unknown setting (harmonics, sampling, peak, window, dt-us, selection, tiles, segment, median-len, scene-removal, video-sampling)", option("sweep")))),
         }
         self.label.push((key.to_string(), value.to_string()));
         Ok(())
@@ -86,16 +88,19 @@ impl Settings {
 pub fn sweep(base: &Settings, sweeps: &[String]) -> Result<Vec<Settings>> {
     let mut out = vec![base.clone()];
     for s in sweeps {
-        let (key, values) = s
-            .split_once('=')
-            .with_context(|| format!("{} {s:?}: expected key=value,value,…", option("sweep")))?;
+        let (key, values) = s.split_once('=').or_fail(Error::Input, || {
+            format!("{} {s:?}: expected key=value,value,…", option("sweep"))
+        })?;
         let values: Vec<&str> = values
             .split(',')
             .map(str::trim)
             .filter(|v| !v.is_empty())
             .collect();
         if values.is_empty() {
-            bail!("{} {s:?}: no values", option("sweep"));
+            return Err(rule(
+                "sweep",
+                format!("{} {s:?}: no values", option("sweep")),
+            ));
         }
         let mut next = Vec::new();
         for settings in &out {

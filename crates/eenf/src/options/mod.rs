@@ -19,64 +19,12 @@ pub mod sound;
 use std::fmt;
 use std::str::FromStr;
 
-use eenf_core::spelling::{option, spelling, Spelling};
 use serde_json::Value;
 
+pub use crate::error::OptionError;
 pub use events::{EventOutputSettings, ExtractSettings, InputSettings, TrackerSettings};
 pub use simulate::{DatasetSettings, SimulateSettings, VideoRenderSettings};
 pub use sound::{AudioSettings, EditSettings, MatchSettings, StoreInputSettings, VideoSettings};
-
-/// Why an option set was refused.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum OptionError {
-    /// A name that none of the sets has.
-    #[error("{}", unknown_words(.0))]
-    Unknown(String),
-    /// A value that cannot be read as its option's type, or lies outside its range.
-    #[error("{}", invalid_words(.name, .value, .reason))]
-    Invalid {
-        /// The option's library name.
-        name: &'static str,
-        /// The value given, as text.
-        value: String,
-        /// What is wrong with it.
-        reason: String,
-    },
-    /// A value that breaks a rule about it or about another option.
-    #[error("{rule}")]
-    Rule {
-        /// The option's library name.
-        name: &'static str,
-        /// The rule, in words (options named by the spelling in force).
-        rule: String,
-    },
-    /// Options given as something other than a JSON object of names and values.
-    #[error("options must be a JSON object of names and values: {0}")]
-    NotAnObject(String),
-}
-
-fn unknown_words(name: &str) -> String {
-    match spelling() {
-        Spelling::Keywords => format!("unexpected keyword argument '{name}'"),
-        Spelling::Flags => format!("unexpected argument '{}'", option(name)),
-        Spelling::Fields => format!("unexpected field '{name}'"),
-    }
-}
-
-fn invalid_words(name: &str, value: &str, reason: &str) -> String {
-    format!("invalid value '{value}' for '{}': {reason}", option(name))
-}
-
-impl OptionError {
-    /// The library name of the option it is about (none for an unknown name).
-    pub fn option(&self) -> Option<&str> {
-        match self {
-            OptionError::Unknown(n) => Some(n),
-            OptionError::Invalid { name, .. } | OptionError::Rule { name, .. } => Some(name),
-            OptionError::NotAnObject(_) => None,
-        }
-    }
-}
 
 /// A set of options that a front end fills by name and the library checks.
 pub trait OptionSet: fmt::Debug {

@@ -55,7 +55,7 @@ impl VideoRenderSettings {
     pub fn cameras(&self) -> Result<Vec<eenf_sim::CameraConfig>, OptionError> {
         match &self.video {
             Some(list) => crate::simulation::parse_cameras(list, self.video_scale)
-                .map_err(|e| rule("video", format!("{e:#}"))),
+                .map_err(|e| rule("video", e.report())),
             None => Ok(Vec::new()),
         }
     }
@@ -411,7 +411,7 @@ impl OptionSet for DatasetSettings {
 
 impl DatasetSettings {
     /// The build of a dataset into `out_dir`.
-    pub fn build(&self, out_dir: PathBuf) -> anyhow::Result<crate::dataset_build::DatasetBuild> {
+    pub fn build(&self, out_dir: PathBuf) -> crate::Result<crate::dataset_build::DatasetBuild> {
         use crate::dataset::DatasetSpec;
         use crate::dataset_build::{parse_local_hour, DatasetBuild, DatasetEnf};
         self.check()?;

@@ -421,9 +421,7 @@ impl StoreInputSettings {
     pub fn build(&self, inputs: Vec<String>) -> Result<crate::reference::StoreBuild, OptionError> {
         self.check()?;
         let start = match self.start.as_deref() {
-            Some(s) => {
-                Some(crate::time::parse_time(s).map_err(|e| rule("start", format!("{e:#}")))?)
-            }
+            Some(s) => Some(crate::time::parse_time(s).map_err(|e| rule("start", e.report()))?),
             None => None,
         };
         Ok(crate::reference::StoreBuild {

@@ -33,7 +33,7 @@ fn hum(phase: &MainsPhase, fs: f64, k: f64, db: f64, seed: u64) -> (Vec<f32>, Ve
     (noisy, clean)
 }
 
-fn trace(samples: &[f32], fs: f64, hum: HumOptions) -> anyhow::Result<Trace> {
+fn trace(samples: &[f32], fs: f64, hum: HumOptions) -> eenf::Result<Trace> {
     let sound = Sound::Samples {
         name: Path::new("hum"),
         interleaved: samples,
@@ -167,7 +167,7 @@ fn clips_of_5_10_and_20_s_with_a_clear_line_are_traced_with_windows_that_fit() {
     let phase = MainsPhase::synthetic(50.0, 3.0, SyntheticEnf::default(), 6);
     let (noisy, _) = hum(&phase, 8000.0, 4.0, 30.0, 6);
     let e = trace(&noisy, 8000.0, HumOptions::default()).unwrap_err();
-    assert!(format!("{e:#}").contains("shorter than"), "{e:#}");
+    assert!(e.report().contains("shorter than"), "{}", e.report());
 }
 
 #[test]
@@ -185,5 +185,5 @@ fn noise_and_lone_tones_near_the_mains_are_refused() {
         .map(|(i, v)| v + 0.05 * (2.0 * std::f64::consts::PI * 349.23 * i as f64 / fs).sin() as f32)
         .collect();
     let e = trace(&tone, fs, HumOptions::default()).unwrap_err();
-    assert!(format!("{e:#}").contains("not the mains"), "{e:#}");
+    assert!(e.report().contains("not the mains"), "{}", e.report());
 }

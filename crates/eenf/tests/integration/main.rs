@@ -14,6 +14,7 @@ mod shared_reference;
 mod unit_archive;
 mod unit_bench_discover;
 mod unit_dataset;
+mod unit_errors;
 mod unit_evaluate;
 mod unit_flac_mask;
 mod unit_output;

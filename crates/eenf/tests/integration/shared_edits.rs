@@ -106,7 +106,7 @@ fn clip(
         .collect()
 }
 
-fn edits_of(samples: &[f32]) -> anyhow::Result<EditReport> {
+fn edits_of(samples: &[f32]) -> eenf::Result<EditReport> {
     let sound = Sound::Samples {
         name: Path::new("clip"),
         interleaved: samples,
@@ -137,7 +137,7 @@ struct Tally {
 
 fn run(hours: &[MainsPhase], kind: &str, clips: usize, scale: f64, seed: u64) -> Tally {
     let span = hours[0].duration_s();
-    let results: Vec<(Edit, anyhow::Result<EditReport>)> = (0..clips)
+    let results: Vec<(Edit, eenf::Result<EditReport>)> = (0..clips)
         .into_par_iter()
         .map(|c| {
             let mut rng = rand::rngs::StdRng::seed_from_u64(seed * 1000 + c as u64);

@@ -149,7 +149,7 @@ fn clip(day: &[Vec<f32>], hour: usize, start: f64, edit: Edit, level: f64, seed:
     x
 }
 
-fn edits_of(samples: &[f32]) -> anyhow::Result<EditReport> {
+fn edits_of(samples: &[f32]) -> eenf::Result<EditReport> {
     let sound = Sound::Samples {
         name: Path::new("clip"),
         interleaved: samples,
@@ -179,7 +179,7 @@ struct Tally {
 
 fn run(day: &[Vec<f32>], kind: &str, clips: usize, level: f64, seed: u64) -> Tally {
     let span = day[0].len() as f64 / FS;
-    let results: Vec<(Edit, anyhow::Result<EditReport>)> = (0..clips)
+    let results: Vec<(Edit, eenf::Result<EditReport>)> = (0..clips)
         .into_par_iter()
         .map(|c| {
             let mut rng = rand::rngs::StdRng::seed_from_u64(seed * 1000 + c as u64);

@@ -22,7 +22,7 @@ fn real_audio(name: &str) -> PathBuf {
         .join(name)
 }
 
-fn audio(path: &Path) -> anyhow::Result<Trace> {
+fn audio(path: &Path) -> eenf::Result<Trace> {
     audio_trace(
         path,
         &AudioOptions::default(),
@@ -51,7 +51,7 @@ fn real_recordings_with_hum_are_traced_on_60_hz_and_the_steady_line_is_flagged()
         ("pyenf_room_16s.wav", 59.95, 60.05),
         ("pyenf_new_record.wav", 59.85, 59.87),
     ] {
-        let t = audio(&real_audio(name)).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+        let t = audio(&real_audio(name)).unwrap_or_else(|e| panic!("{name}: {}", e.report()));
         assert_eq!(t.nominal_hz, Some(60.0), "{name}");
         let finite: Vec<f64> = t.finite().collect();
         let mean = finite.iter().sum::<f64>() / finite.len() as f64;
@@ -67,7 +67,7 @@ fn real_recordings_with_hum_are_traced_on_60_hz_and_the_steady_line_is_flagged()
         }
     }
     let e = audio(&real_audio("enfwhu_H0_01_no_enf_1kHz.wav")).unwrap_err();
-    assert!(format!("{e:#}").contains("no mains line"), "{e:#}");
+    assert!(e.report().contains("no mains line"), "{}", e.report());
 }
 
 #[test]

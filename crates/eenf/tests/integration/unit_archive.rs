@@ -1,9 +1,9 @@
 //! Tests of eenf's `archive` (kept out of the library so that `cargo test` does not
 //! compile the library a second time).
 
-use anyhow::Result;
 use eenf::archive::*;
 use eenf::time::Zone;
+use eenf::Result;
 use std::path::Path;
 
 fn layout(text: &str, opts: &ArchiveOptions) -> Result<Layout> {

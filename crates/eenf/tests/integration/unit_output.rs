@@ -32,7 +32,7 @@ fn written_whole_through_links_and_devices() {
         .is_symlink());
     assert_eq!(std::fs::read_to_string(&real).unwrap(), "new");
     // a failed write leaves the old file and no temporary
-    assert!(write_atomic(&real, |_| anyhow::bail!("no")).is_err());
+    assert!(write_atomic(&real, |_| Err(eenf::Error::Output("no".into()))).is_err());
     assert_eq!(std::fs::read_to_string(&real).unwrap(), "new");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
     write_atomic(Path::new("/dev/null"), |w| Ok(w.write_all(b"x")?)).unwrap();
