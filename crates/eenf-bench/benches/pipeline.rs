@@ -95,7 +95,7 @@ fn benches(c: &mut Criterion) {
         });
         if format == OutputFormat::Aedat4(Compression::Lz4) {
             let opts = ExtractOptions {
-                nominal: Nominal::Hz(50.0),
+                nominal: Nominal::Grid(eenf_core::Grid::Hz50),
                 ..ExtractOptions::default()
             };
             g.bench_function("extract_enf", |b| {

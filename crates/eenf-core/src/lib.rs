@@ -16,5 +16,5 @@ pub mod signal;
 pub mod spelling;
 
 pub use batch::EventBatch;
-pub use grid::Nominal;
+pub use grid::{Grid, Nominal};
 pub use signal::Signal;

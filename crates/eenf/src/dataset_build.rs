@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{rule, Context, Result};
 use eenf_core::spelling::option;
+use eenf_core::Grid;
 use eenf_events::writers::OutputFormat;
 use eenf_events::Compression;
 use eenf_sim::CameraConfig;
@@ -26,11 +27,11 @@ pub enum DatasetEnf {
     /// Real mains WAVs, hourly files named like `2022_08_17_Wed_16_00_00.wav` in this folder;
     /// they become the references.
     WavDir(PathBuf),
-    /// A synthetic grid of `grid_hz` (50 or 60) over six hours from `from_local_s` (local
-    /// seconds); the references are synthesized.
+    /// A synthetic `grid` over six hours from `from_local_s` (local seconds); the
+    /// references are synthesized.
     Synthetic {
-        /// 50 or 60.
-        grid_hz: f64,
+        /// The grid.
+        grid: Grid,
         /// Local seconds of the first hour.
         from_local_s: i64,
     },
@@ -106,15 +107,9 @@ pub fn build_dataset(
 ) -> Result<DatasetBuilt> {
     let timeline = match &b.enf {
         DatasetEnf::WavDir(dir) => EnfTimeline::wav_dir(dir)?,
-        DatasetEnf::Synthetic {
-            grid_hz,
-            from_local_s,
-        } => {
-            if *grid_hz != 50.0 && *grid_hz != 60.0 {
-                return Err(rule("grid", format!("{} must be 50 or 60", option("grid"))));
-            }
+        DatasetEnf::Synthetic { grid, from_local_s } => {
             let from = *from_local_s as f64;
-            EnfTimeline::synthetic(*grid_hz, from, from + 6.0 * 3600.0, b.spec.seed ^ 0xe4f)
+            EnfTimeline::synthetic(*grid, from, from + 6.0 * 3600.0, b.spec.seed ^ 0xe4f)
         }
     };
     let (plans, duration) = plan_dataset(&b.spec, timeline.coverage()?)?;
@@ -194,7 +189,7 @@ fn write_dataset(
         "duration_s": duration,
         "resolution": [width, height],
         "enf": timeline.describe(),
-        "nominal_hz": timeline.nominal_hz(),
+        "nominal_hz": timeline.grid().hz(),
         "utc_offset_s": tz,
         "seed": b.spec.seed,
         "events": total_events,
@@ -244,7 +239,7 @@ fn write_one(
         &Progress::hidden(),
     )?;
     // the flicker line's prominence: what the realistic scenes are calibrated by
-    let line = crate::extract::grid_line(&path, &Default::default(), timeline.nominal_hz())?;
+    let line = crate::extract::grid_line(&path, &Default::default(), timeline.grid())?;
     let prominence = line.map_or(String::new(), |l| format!("{:.2}", l.prominence));
     let (reference, offset_s) = if scored_against_truth(&b.spec.preset) {
         (relative(out, &sim.truth), 0)

@@ -390,7 +390,7 @@ pub fn trace_edits(trace: &Trace, path: &Path, params: &EditParams) -> Result<Ed
             (2 * side + 1) as f64 * step
         );
     }
-    let grid_hz = trace.grid_or_err(path)?;
+    let grid_hz = trace.grid_or_err(path)?.hz();
     // a line fitted to each side, both carried to the boundary: the grid's own ramps cancel,
     // a jump of the level stays
     let end_value = |a: usize, b: usize, at: f64| -> Option<f64> {

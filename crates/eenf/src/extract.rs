@@ -15,7 +15,7 @@ use crate::flicker_map::{flicker_map_of, TileMask};
 use crate::progress::Progress;
 use crate::recording::{Peeked, Recording};
 use crate::trace::{EventsProvenance, Trace};
-use eenf_core::Nominal;
+use eenf_core::{Grid, Nominal};
 
 /// How events become a trace.
 #[derive(Debug, Clone)]
@@ -148,11 +148,11 @@ pub fn camera_line(
     Ok(flicker_line(&s.seq.signal(), s.seq.fs()))
 }
 
-/// The flicker line of `path` at the grid `grid_hz` (50 or 60 Hz), measured as the issue of
+/// The flicker line of `path` at `grid`, measured as the issue of
 /// real recordings calibrates scenes: the whole recording's 1 ms ON − OFF sums, Hann window,
 /// the peak near 2·grid over the median magnitude in 80–140 Hz. `None` when the recording is
 /// too short to measure.
-pub fn grid_line(path: &Path, open: &OpenOptions, grid_hz: f64) -> Result<Option<FlickerLine>> {
+pub fn grid_line(path: &Path, open: &OpenOptions, grid: Grid) -> Result<Option<FlickerLine>> {
     let s = sample_with(
         &Recording::file(path),
         open,
@@ -161,7 +161,7 @@ pub fn grid_line(path: &Path, open: &OpenOptions, grid_hz: f64) -> Result<Option
         &Progress::hidden(),
     )?;
     let lines = flicker_lines(&s.seq.signal(), s.seq.fs());
-    Ok(lines.map(|[a, b]| if grid_hz == 60.0 { b } else { a }))
+    Ok(lines.map(|[a, b]| if grid == Grid::Hz60 { b } else { a }))
 }
 
 /// Reads a recording into its flicker signal. A file with several cameras (a stereo pair,
@@ -288,7 +288,7 @@ fn decide_grid(
     let line = match (nominal, lines) {
         (_, None) => None,
         (Nominal::Auto, Some([a, b])) => Some(if a.prominence >= b.prominence { a } else { b }),
-        (Nominal::Hz(f), Some([a, b])) => Some(if f == 50.0 { a } else { b }),
+        (Nominal::Grid(g), Some([a, b])) => Some(if g == Grid::Hz50 { a } else { b }),
     };
     let f0 = match (nominal, line) {
         (Nominal::Auto, Some(l)) if l.is_mains() => l.grid_hz,
@@ -300,7 +300,8 @@ fn decide_grid(
         }
         // too short or sampled too slowly for the whole-recording line: the older local test
         (Nominal::Auto, None) => detect_nominal(x, fs, 2.0)?,
-        (Nominal::Hz(f), l) => {
+        (Nominal::Grid(g), l) => {
+            let f = g.hz();
             // the flicker line may be weak at 2f0 yet strong at a higher harmonic
             let ok = l.is_some_and(|l| l.is_mains())
                 || (1..=harmonics.max(1)).any(|m| check_line(x, fs, f, 2.0 * m as f64).is_ok());
@@ -348,10 +349,8 @@ pub fn extract_sampled(
     let mut params = opts.params.clone();
     // a finely sampled signal is brought down to the rate its bands need, without letting
     // the flicker's higher harmonics fold onto them
-    let grid = match opts.nominal {
-        Nominal::Hz(f) => f,
-        Nominal::Auto => 60.0,
-    };
+    // undecided: the higher grid's bands, which hold the lower's
+    let grid = opts.nominal.hz().unwrap_or(60.0);
     let top = 2.0 * grid * params.harmonics.max(1) as f64 + params.half_band_hz;
     let (x, fs) = flicker_signal(seq, top);
     let mut notes = s.notes;

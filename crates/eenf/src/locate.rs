@@ -1,6 +1,7 @@
 //! `match`: where a trace fits in long references, and when it was therefore recorded.
 
 use eenf_core::spelling::option;
+use eenf_core::Grid;
 use std::path::Path;
 
 use crate::error::{fail, Context, Error, Result};
@@ -45,8 +46,8 @@ pub struct Verified {
 /// The outcome of `match`: the best places over every series, best first.
 #[derive(Debug, Clone)]
 pub struct MatchReport {
-    /// The grid searched, Hz.
-    pub nominal_hz: f64,
+    /// The grid searched.
+    pub grid: Grid,
     /// The best candidates over all series (lowest p-value, then highest CC).
     pub placements: Vec<Placement>,
     /// The claimed time's fit, when one was given and falls inside a series.
@@ -82,18 +83,18 @@ pub fn locate(
     query: &MatchQuery,
     progress: &Progress,
 ) -> Result<Located> {
-    let nominal_hz = match_grid(trace, name)?;
-    let references = ReferenceSeries::load(reference, nominal_hz, zone, progress)?;
-    let report = locate_in(trace, name, nominal_hz, &references, query)?;
+    let grid = match_grid(trace, name)?;
+    let references = ReferenceSeries::load(reference, grid, zone, progress)?;
+    let report = locate_in(trace, name, grid, &references, query)?;
     Ok(Located { report, references })
 }
 
-/// Where `trace` (named `name`, on the `nominal_hz` grid [`match_grid`] found) fits in the
+/// Where `trace` (named `name`, on the `grid` [`match_grid`] found) fits in the
 /// series `refs`, as `query` asks.
 pub fn locate_in(
     trace: &Trace,
     name: &Path,
-    nominal_hz: f64,
+    grid: Grid,
     refs: &[ReferenceSeries],
     query: &MatchQuery,
 ) -> Result<MatchReport> {
@@ -148,7 +149,7 @@ pub fn locate_in(
     });
     placements.truncate(query.top);
     Ok(MatchReport {
-        nominal_hz,
+        grid,
         placements,
         verified,
         seconds: started.elapsed().as_secs_f64(),
@@ -157,7 +158,7 @@ pub fn locate_in(
 
 /// The grid of a trace to be matched: it must hold two values, rising times, and a mean on a
 /// 50 or 60 Hz grid.
-pub fn match_grid(trace: &Trace, name: &Path) -> Result<f64> {
+pub fn match_grid(trace: &Trace, name: &Path) -> Result<Grid> {
     if trace.enf_hz.len() < 2 {
         fail!(Input, "{}: too short to match", name.display());
     }
@@ -183,7 +184,7 @@ impl MatchReport {
             })
             .collect();
         serde_json::json!({
-            "trace": trace, "nominal_hz": self.nominal_hz, "alpha": alpha, "seconds": self.seconds,
+            "trace": trace, "nominal_hz": self.grid.hz(), "alpha": alpha, "seconds": self.seconds,
             "candidates": cands,
             "verify": self.verified.as_ref().map(|v| {
                 let (r, v) = (&refs[v.series], &v.verification);

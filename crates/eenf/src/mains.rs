@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::error::{error, fail, Error, Result};
+use crate::error::{error, fail, Error, Missing, Result};
 use eenf_dsp::hum::{MAX_HUM_HARMONIC, MIN_CLIP_S};
 use eenf_dsp::{
     check_holds_line, choose_window, enf_from_hum_lines, plausibility, reference_enf_with_snr,
@@ -12,11 +12,11 @@ use eenf_dsp::{
 
 use crate::audio::{AudioOptions, Sound};
 use crate::trace::{AudioProvenance, HumReport, MainsProvenance, Provenance, Trace};
-use eenf_core::Nominal;
 use eenf_core::Signal;
+use eenf_core::{Grid, Nominal};
 
 /// Decides or checks the nominal frequency of a mains signal: the line detector on f0 alone.
-pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<f64> {
+pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<Grid> {
     let err = |e: eenf_dsp::DspError| Error::from(e).context(path.display());
     let grids = grids_of(nominal);
     let top = grids.iter().fold(0.0f64, |a, &b| a.max(b));
@@ -34,15 +34,22 @@ pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<f64>
             window_s: 1.0,
         })
     })?;
-    Ok(search.verdict().map_err(err)?.grid_hz)
+    grid_of_verdict(search.verdict().map_err(err)?.grid_hz, path)
+}
+
+/// The grid a hum search chose (it only tries the grids it was given: 50 and 60 Hz).
+fn grid_of_verdict(hz: f64, path: &Path) -> Result<Grid> {
+    Grid::of_hz(hz).or_fail(Error::Method, || {
+        format!("{}: no grid at {hz} Hz", path.display())
+    })
 }
 
 /// The grids a `--nominal` leaves open.
 pub(crate) fn grids_of(nominal: Nominal) -> &'static [f64] {
     match nominal {
         Nominal::Auto => &[50.0, 60.0],
-        Nominal::Hz(50.0) => &[50.0],
-        Nominal::Hz(_) => &[60.0],
+        Nominal::Grid(Grid::Hz50) => &[50.0],
+        Nominal::Grid(Grid::Hz60) => &[60.0],
     }
 }
 
@@ -161,7 +168,7 @@ pub fn sound_trace(
         // the method's reference tracker: f0 alone, unfiltered
         let f0 = mains_nominal(&a.signal, nominal, path)?;
         let p = EnfParams {
-            nominal_hz: f0,
+            nominal_hz: f0.hz(),
             window_s: hum.window_s.unwrap_or(params.window_s),
             ..params.clone()
         };
@@ -193,7 +200,8 @@ pub fn sound_trace(
         )
     })?;
     let verdict = search.verdict().map_err(err)?;
-    let f0 = verdict.grid_hz;
+    let grid = grid_of_verdict(verdict.grid_hz, path)?;
+    let f0 = grid.hz();
     let (window_s, window_note) = match hum.window_s {
         Some(w) => (w, None),
         None => choose_window(
@@ -223,13 +231,13 @@ pub fn sound_trace(
         let (enf, snr_db) = reference_enf_with_snr(&sig.samples, sig.fs, &p).map_err(err)?;
         Trace {
             snr_db,
-            ..Trace::from_mains(path, f0, &p, enf)
+            ..Trace::from_mains(path, grid, &p, enf)
         }
     } else {
         let estimates = enf_from_hum_lines(&sig.samples, sig.fs, &p, &carriers).map_err(err)?;
         Trace::from_mains_lines(
             path,
-            f0,
+            grid,
             &estimates,
             MainsProvenance {
                 peak: p.peak,

@@ -18,7 +18,7 @@ use crate::refdb::{check_grid_name, StoreLock, StoredGrid, GAP};
 use crate::time::{LocalInstant, LocalTime, Zone};
 use crate::trace::Trace;
 use crate::wav::is_wav;
-use eenf_core::Nominal;
+use eenf_core::{Grid, Nominal};
 
 /// Where a reference comes from, told from what is at its path: the one place that decides.
 /// `compare` takes a window of it, `match` searches it, `refdb build` adds it to a store.
@@ -136,7 +136,7 @@ pub fn reference_for_recording(
     let a = from.saturating_sub(margin);
     let b = ((need_until as f64 * fs) as usize).min(samples.len());
     let p = EnfParams {
-        nominal_hz: f0,
+        nominal_hz: f0.hz(),
         ..params.clone()
     };
     let slice = &samples[(a as f64 * fs) as usize..b];
@@ -280,15 +280,16 @@ impl ReferenceSeries {
         }
     }
 
-    /// The `nominal` Hz series at `path`: a store (its grids of that frequency), a folder of
+    /// The series of `grid` at `path`: a store (its grids of that frequency), a folder of
     /// hourly WAVs (traced, local names in `zone`), a WAV, a grid archive (local times in
     /// `zone`), or a trace file.
     pub fn load(
         path: &Path,
-        nominal: f64,
+        grid: Grid,
         zone: Option<&Zone>,
         progress: &Progress,
     ) -> Result<Vec<Self>> {
+        let nominal = grid.hz();
         let source = ReferenceSource::open(path)?;
         if matches!(
             source,
@@ -354,7 +355,7 @@ impl ReferenceSeries {
         if let ReferenceSource::Archive(_) = source {
             let opts = ArchiveOptions {
                 zone: zone.cloned(),
-                nominal_hz: Some(nominal),
+                grid: Some(grid),
                 ..ArchiveOptions::default()
             };
             let imp = crate::archive::import(path, &opts, None)?;
@@ -377,7 +378,7 @@ impl ReferenceSeries {
                 .collect());
         }
         let (start, absolute, step, hz) = if let ReferenceSource::Wav(_) = source {
-            let trace = reference_file(path, Nominal::Hz(nominal), &EnfParams::default())?;
+            let trace = reference_file(path, Nominal::Grid(grid), &EnfParams::default())?;
             if crate::dataset::reference_hour(path).is_some() {
                 (wav_start(path, zone)?, true, 1.0, trace.enf_hz)
             } else {
@@ -503,12 +504,12 @@ pub fn build_store(
             };
             let ArchiveImport {
                 steps,
-                nominal_hz,
+                grid,
                 report,
             } = crate::archive::import(path, &opts, None)?;
             archives.push((path.clone(), report));
             let pieces = steps.into_iter().map(|p| (p.start, p.step, p.values));
-            (pieces.collect(), nominal_hz)
+            (pieces.collect(), grid)
         } else {
             let trace = read_series(path, build.index_step_s)?;
             let start = at.or(next_start).or_fail(Error::Input, || {
@@ -528,24 +529,21 @@ pub fn build_store(
         if let Some((last_start, last_step, last)) = pieces.last() {
             next_start = Some(last_start + last.len() as f64 * last_step);
         }
-        let grid = build
-            .grid
-            .clone()
-            .unwrap_or_else(|| format!("grid{}", f0 as u32));
+        let grid = build.grid.clone().unwrap_or_else(|| format!("grid{f0}"));
         let idx = match series.iter().position(|s| s.meta.grid == grid) {
             Some(i) => i,
             None => {
                 let s = if store.join(format!("{grid}.json")).exists() {
                     StoredGrid::load(store, &grid)?
                 } else {
-                    StoredGrid::new(&grid, f0, step, start)
+                    StoredGrid::new(&grid, f0.hz(), step, start)
                 };
                 series.push(s);
                 series.len() - 1
             }
         };
         let s = &mut series[idx];
-        if s.meta.nominal_hz != f0 {
+        if s.meta.nominal_hz != f0.hz() {
             fail!(Reference,
                 "{}: a {f0} Hz trace cannot go into grid {grid:?}, which is {} Hz (50 and 60 Hz are never mixed)",
                 path.display(),
@@ -590,7 +588,7 @@ fn read_series(path: &Path, index_step_s: Option<f64>) -> Result<Trace> {
 }
 
 /// The grid of a trace's values, 50 or 60 Hz.
-fn nominal_of(trace: &Trace, path: &Path) -> Result<f64> {
+fn nominal_of(trace: &Trace, path: &Path) -> Result<Grid> {
     if trace.finite().next().is_none() {
         fail!(Reference, "{}: no values", path.display());
     }

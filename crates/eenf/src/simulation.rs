@@ -18,7 +18,7 @@ use crate::reference::ReferenceSource;
 use crate::time::{offset_of, parse_time, LocalTime};
 use crate::trace::Trace;
 use crate::wav::write_wav;
-use eenf_core::Nominal;
+use eenf_core::{Grid, Nominal};
 
 /// Sampling rate of synthesized mains references (the dataset's).
 pub const REFERENCE_FS: u32 = 400;
@@ -28,8 +28,8 @@ pub const REFERENCE_FS: u32 = 400;
 pub enum EnfTimeline {
     /// A frequency series (synthetic, or read from a trace CSV) from `t0` at `step_s` steps.
     Series {
-        /// Nominal frequency, Hz.
-        nominal_hz: f64,
+        /// The grid.
+        grid: Grid,
         /// Frequency values, Hz.
         values: Vec<f64>,
         /// Seconds between values.
@@ -41,8 +41,8 @@ pub enum EnfTimeline {
     },
     /// Mains recordings: hourly WAVs (or one WAV) starting at the given local times.
     Mains {
-        /// Nominal frequency, Hz.
-        nominal_hz: f64,
+        /// The grid.
+        grid: Grid,
         /// (local start, path), sorted.
         files: Vec<(f64, PathBuf)>,
     },
@@ -50,15 +50,15 @@ pub enum EnfTimeline {
 
 impl EnfTimeline {
     /// A synthetic grid covering `from..to` (local seconds), whole hours.
-    pub fn synthetic(nominal_hz: f64, from: f64, to: f64, seed: u64) -> Self {
+    pub fn synthetic(grid: Grid, from: f64, to: f64, seed: u64) -> Self {
         let t0 = (from / 3600.0).floor() * 3600.0 - 2.0;
         let n = ((to - t0) / 3600.0).ceil() as usize * 3600 + 8;
         EnfTimeline::Series {
-            nominal_hz,
-            values: SyntheticEnf::default().per_second(nominal_hz, n, seed),
+            grid,
+            values: SyntheticEnf::default().per_second(grid.hz(), n, seed),
             step_s: 1.0,
             t0,
-            source: format!("synthetic {nominal_hz} Hz grid, seed {seed}"),
+            source: format!("synthetic {grid} Hz grid, seed {seed}"),
         }
     }
 
@@ -75,17 +75,14 @@ impl EnfTimeline {
             );
         }
         let mean = values.iter().sum::<f64>() / values.len() as f64;
-        let nominal_hz = [50.0, 60.0]
-            .into_iter()
-            .find(|f| (mean - f).abs() < 1.0)
-            .or_fail(Error::Input, || {
-                format!(
-                    "{}: mean {mean:.3} Hz is neither a 50 nor a 60 Hz grid",
-                    path.display()
-                )
-            })?;
+        let grid = Grid::near(mean).or_fail(Error::Input, || {
+            format!(
+                "{}: mean {mean:.3} Hz is neither a 50 nor a 60 Hz grid",
+                path.display()
+            )
+        })?;
         Ok(EnfTimeline::Series {
-            nominal_hz,
+            grid,
             values,
             step_s,
             t0,
@@ -96,9 +93,9 @@ impl EnfTimeline {
     /// One mains WAV starting at local time `t0`.
     pub fn wav(path: &Path, t0: f64) -> Result<Self> {
         let sig = read_wav(path)?;
-        let nominal_hz = mains_nominal(&sig, Nominal::Auto, path)?;
+        let grid = mains_nominal(&sig, Nominal::Auto, path)?;
         Ok(EnfTimeline::Mains {
-            nominal_hz,
+            grid,
             files: vec![(t0, path.to_path_buf())],
         })
     }
@@ -108,9 +105,9 @@ impl EnfTimeline {
         let refs = hourly_references(dir)?;
         let first = &refs[0].1;
         let sig = read_wav(first)?;
-        let nominal_hz = mains_nominal(&sig, Nominal::Auto, first)?;
+        let grid = mains_nominal(&sig, Nominal::Auto, first)?;
         Ok(EnfTimeline::Mains {
-            nominal_hz,
+            grid,
             files: refs
                 .into_iter()
                 .map(|(t, p)| (t.local_seconds() as f64, p))
@@ -118,12 +115,10 @@ impl EnfTimeline {
         })
     }
 
-    /// Nominal frequency, Hz.
-    pub fn nominal_hz(&self) -> f64 {
+    /// The grid.
+    pub fn grid(&self) -> Grid {
         match self {
-            EnfTimeline::Series { nominal_hz, .. } | EnfTimeline::Mains { nominal_hz, .. } => {
-                *nominal_hz
-            }
+            EnfTimeline::Series { grid, .. } | EnfTimeline::Mains { grid, .. } => *grid,
         }
     }
 
@@ -155,7 +150,7 @@ impl EnfTimeline {
     pub fn phase(&self, start: f64, duration_s: f64) -> Result<MainsPhase> {
         match self {
             EnfTimeline::Series {
-                nominal_hz,
+                grid,
                 values,
                 step_s,
                 t0,
@@ -174,7 +169,7 @@ impl EnfTimeline {
                 // the phase runs on from the series' start, so pieces cut from one series
                 // (a recording, the hourly references) join without a phase step
                 Ok(MainsPhase::from_frequency(
-                    *nominal_hz,
+                    grid.hz(),
                     values,
                     *step_s,
                     start - t0,
@@ -182,7 +177,7 @@ impl EnfTimeline {
                     eenf_sim::phase_from_start(values, *step_s, start - t0),
                 ))
             }
-            EnfTimeline::Mains { nominal_hz, files } => {
+            EnfTimeline::Mains { grid, files } => {
                 // the files holding [start, start + duration], read and joined
                 let end = start + duration_s;
                 let mut samples = Vec::new();
@@ -223,7 +218,7 @@ impl EnfTimeline {
                         "no mains recording covers local time {start:.0} s"
                     );
                 };
-                MainsPhase::from_recording(&samples, fs, *nominal_hz, start - ft, duration_s)
+                MainsPhase::from_recording(&samples, fs, grid.hz(), start - ft, duration_s)
                     .map_err(|e| error!(Simulation, "{}: {e}", files[0].1.display()))
             }
         }
@@ -482,7 +477,7 @@ pub struct VideoFiles {
 #[derive(Debug, Clone)]
 pub enum EnfSource {
     /// A synthetic grid of this nominal frequency (50 or 60 Hz).
-    Synthetic(f64),
+    Synthetic(Grid),
     /// A mains WAV or a trace CSV, from `offset_s` into it; an `index,value` CSV has values
     /// `index_step_s` apart.
     File {
@@ -526,7 +521,7 @@ impl Recipe {
     pub fn new(config: SimConfig, output: PathBuf) -> Self {
         Recipe {
             config,
-            enf: EnfSource::Synthetic(50.0),
+            enf: EnfSource::Synthetic(Grid::Hz50),
             start: DEFAULT_START.to_string(),
             output,
             format: OutputFormat::Aedat4(eenf_events::Compression::Lz4),
@@ -569,9 +564,6 @@ pub fn recipe_timeline(r: &Recipe) -> Result<(EnfTimeline, f64, f64)> {
     let duration = r.config.duration_s;
     match &r.enf {
         EnfSource::Synthetic(grid) => {
-            if *grid != 50.0 && *grid != 60.0 {
-                return Err(rule("grid", format!("{} must be 50 or 60", option("grid"))));
-            }
             let (start, tz) = local_start(&r.start, None, 0.0)?;
             let seed = r.config.seed ^ 0x5eed;
             let t = EnfTimeline::synthetic(*grid, start, start + duration, seed);

@@ -6,6 +6,7 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{error, fail, Context, Error, Missing, Result};
+use eenf_core::Grid;
 use eenf_dsp::{
     EnfEstimates, EnfParams, FlickerLine, HumSearch, PeakMethod, Plausibility, SamplingMethod,
 };
@@ -261,12 +262,12 @@ impl Trace {
     /// The trace of a mains or audio recording whose lines were tracked band by band.
     pub fn from_mains_lines(
         file: &Path,
-        nominal_hz: f64,
+        grid: Grid,
         estimates: &EnfEstimates,
         provenance: MainsProvenance,
     ) -> Self {
         Trace {
-            nominal_hz: Some(nominal_hz),
+            nominal_hz: Some(grid.hz()),
             provenance: Some(Provenance::Mains(provenance)),
             ..Trace::from_estimates(file, estimates)
         }
@@ -325,10 +326,10 @@ impl Trace {
     }
 
     /// The reference trace of a mains recording, tracked on a `nominal_hz` grid with `params`.
-    pub fn from_mains(file: &Path, nominal_hz: f64, params: &EnfParams, enf_hz: Vec<f64>) -> Self {
+    pub fn from_mains(file: &Path, grid: Grid, params: &EnfParams, enf_hz: Vec<f64>) -> Self {
         Trace {
             file: Some(file.to_path_buf()),
-            nominal_hz: Some(nominal_hz),
+            nominal_hz: Some(grid.hz()),
             provenance: Some(Provenance::Mains(MainsProvenance {
                 peak: params.peak,
                 window_s: params.window_s,
@@ -438,15 +439,14 @@ impl Trace {
         }
     }
 
-    /// The grid a trace's values lie on: 50 or 60 Hz, from their mean.
-    pub fn grid_hz(&self) -> Option<f64> {
-        let mean = self.mean_hz();
-        [50.0, 60.0].into_iter().find(|f| (mean - f).abs() < 1.0)
+    /// The grid a trace's values lie on, from their mean.
+    pub fn grid(&self) -> Option<Grid> {
+        Grid::near(self.mean_hz())
     }
 
-    /// [`Trace::grid_hz`], or an error naming the trace `name` and its mean.
-    pub fn grid_or_err(&self, name: &Path) -> Result<f64> {
-        self.grid_hz().ok_or_else(|| {
+    /// [`Trace::grid`], or an error naming the trace `name` and its mean.
+    pub fn grid_or_err(&self, name: &Path) -> Result<Grid> {
+        self.grid().ok_or_else(|| {
             error!(
                 Input,
                 "{}: mean {:.3} Hz is neither a 50 nor a 60 Hz grid",

@@ -84,7 +84,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         &sim.truth,
         0.0,
         eenf::trace::INDEX_STEP_S,
-        Nominal::Hz(50.0),
+        Nominal::Grid(eenf_core::Grid::Hz50),
         &EnfParams::default(),
     )?;
     let compare_plot = sibling(&recording, "compare.png");

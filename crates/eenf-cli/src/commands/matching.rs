@@ -48,7 +48,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         }
     }
     let (report, refs) = (&located.report, &located.references);
-    let nominal = report.nominal_hz;
+    let nominal = report.grid.hz();
     let rows: Vec<_> = report
         .placements
         .iter()

@@ -26,9 +26,13 @@ fn hours50() -> Vec<f64> {
     let wavs = common::reference_wavs();
     let mut all = Vec::new();
     for w in wavs {
-        let t = reference_file(&w, Nominal::Hz(50.0), &EnfParams::default())
-            .unwrap()
-            .enf_hz;
+        let t = reference_file(
+            &w,
+            Nominal::Grid(eenf_core::Grid::Hz50),
+            &EnfParams::default(),
+        )
+        .unwrap()
+        .enf_hz;
         all.extend_from_slice(&t[..3600]);
     }
     all
@@ -173,7 +177,12 @@ fn an_eenf_trace_from_a_simulated_recording_is_placed_at_its_time() {
 fn local_file_names_need_their_zone() {
     let refs = common::shared("enf-reference").join("enf-reference");
     let hour = refs.join("2022_08_17_Wed_17_00_00.wav");
-    let trace = reference_file(&hour, Nominal::Hz(50.0), &EnfParams::default()).unwrap();
+    let trace = reference_file(
+        &hour,
+        Nominal::Grid(eenf_core::Grid::Hz50),
+        &EnfParams::default(),
+    )
+    .unwrap();
     let dir = tempfile::tempdir().unwrap();
     let clip = dir.path().join("clip.csv");
     let mut text = String::from("time_s,enf_hz\n");

@@ -2,6 +2,7 @@
 //! row's time and its value, the value's unit, the decimal mark, the date order and the zone.
 
 use eenf_core::spelling::{option, option_with};
+use eenf_core::Grid;
 use std::path::Path;
 
 use crate::error::{fail, Error, Missing, Result};
@@ -151,7 +152,7 @@ impl Layout {
     }
 
     /// The nominal frequency from the first rows' values.
-    pub(super) fn nominal(&self, lines: &[String], label: &str) -> Result<f64> {
+    pub(super) fn nominal(&self, lines: &[String], label: &str) -> Result<Grid> {
         let vals: Vec<f64> = lines[self.first_data..]
             .iter()
             .filter_map(|l| {
@@ -166,9 +167,9 @@ impl Layout {
             ValueUnit::Auto | ValueUnit::Hz => {
                 let m = median(vals).unwrap_or(f64::NAN);
                 if (45.0..55.0).contains(&m) {
-                    Ok(50.0)
+                    Ok(Grid::Hz50)
                 } else if (55.0..65.0).contains(&m) {
-                    Ok(60.0)
+                    Ok(Grid::Hz60)
                 } else {
                     fail!(Archive, "{label}: its values (median {m}) are not near 50 or 60 Hz")
                 }

@@ -19,6 +19,7 @@
 //! (0 Hz dropouts, say) are dropped as gaps and counted.
 
 use eenf_core::spelling::option_with;
+use eenf_core::Grid;
 use std::fmt;
 use std::fs::File;
 use std::io::{BufReader, Read};
@@ -131,8 +132,8 @@ impl ArchiveFormat {
     }
 
     /// The grid its publisher measures (all named layouts are European, 50 Hz).
-    fn nominal(self) -> Option<f64> {
-        (self != ArchiveFormat::Auto).then_some(50.0)
+    fn nominal(self) -> Option<Grid> {
+        (self != ArchiveFormat::Auto).then_some(Grid::Hz50)
     }
 
     /// The order of day and month it writes.
@@ -248,8 +249,8 @@ pub struct ArchiveOptions {
     pub unit: ValueUnit,
     /// The order of day and month in its dates.
     pub date_order: DateOrder,
-    /// The grid's nominal frequency (needed for deviations; else told from the values).
-    pub nominal_hz: Option<f64>,
+    /// The grid (needed for deviations; else told from the values).
+    pub grid: Option<Grid>,
 }
 
 /// An archive read onto regular steps.
@@ -258,8 +259,8 @@ pub struct ArchiveImport {
     /// The frequency, Hz, at Unix times `start + i·step` (NaN: a gap), in time order; a new
     /// piece starts after a gap of more than six hours.
     pub steps: Vec<Steps>,
-    /// The grid's nominal frequency, Hz.
-    pub nominal_hz: f64,
+    /// The grid.
+    pub grid: Grid,
     /// What was read, and what was dropped.
     pub report: ImportReport,
 }
@@ -409,8 +410,8 @@ pub fn import(path: &Path, opts: &ArchiveOptions, step_s: Option<f64>) -> Result
         }
         let layout = sniff(&lines, opts, Path::new(&label))?;
         if state.is_none() {
-            let nominal = match opts.nominal_hz {
-                Some(f) => f,
+            let nominal = match opts.grid {
+                Some(g) => g,
                 None => layout.nominal(&lines, &label)?,
             };
             let native = layout.native_step(&lines);
@@ -482,7 +483,7 @@ pub fn import(path: &Path, opts: &ArchiveOptions, step_s: Option<f64>) -> Result
             }
         });
     }
-    let nominal = st.nominal;
+    let grid = st.grid;
     let step = st.acc.step();
     let interpolate = if st.native > st.acc.step() * 1.01 {
         st.native * 1.5
@@ -504,7 +505,7 @@ pub fn import(path: &Path, opts: &ArchiveOptions, step_s: Option<f64>) -> Result
     }
     Ok(ArchiveImport {
         steps: pieces,
-        nominal_hz: nominal,
+        grid,
         report,
     })
 }

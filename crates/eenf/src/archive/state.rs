@@ -1,6 +1,7 @@
 //! The state of one import: rows placed on the store's steps, clock changes counted, and
 //! rows that bring no later time bounded.
 
+use eenf_core::Grid;
 use eenf_dsp::resample::StepAverager;
 
 use super::layout::{Layout, ZoneRule};
@@ -16,7 +17,7 @@ pub(super) enum ClockNote {
 
 /// The state of one import: the steps so far and the last row's instant.
 pub(super) struct ImportState {
-    pub(super) nominal: f64,
+    pub(super) grid: Grid,
     pub(super) native: f64,
     pub(super) acc: StepAverager,
     pub(super) last: f64,
@@ -29,9 +30,9 @@ pub(super) struct ImportState {
 }
 
 impl ImportState {
-    pub(super) fn new(nominal: f64, step: f64, native: f64) -> Self {
+    pub(super) fn new(grid: Grid, step: f64, native: f64) -> Self {
         ImportState {
-            nominal,
+            grid,
             native,
             acc: StepAverager::new(step, (MAX_SPAN_S / step) as usize),
             last: f64::NEG_INFINITY,
@@ -161,8 +162,9 @@ impl ImportState {
             self.latest = instant;
             self.stale = 0;
         }
-        let hz = layout.unit.to_hz(v, self.nominal);
-        if (hz - self.nominal).abs().is_nan() || (hz - self.nominal).abs() > PLAUSIBLE_HZ {
+        let nominal = self.grid.hz();
+        let hz = layout.unit.to_hz(v, nominal);
+        if (hz - nominal).abs().is_nan() || (hz - nominal).abs() > PLAUSIBLE_HZ {
             report.implausible += 1;
             return;
         }

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use eenf_core::spelling::option;
+use eenf_core::Grid;
 use eenf_events::writers::OutputFormat;
 use eenf_sim::{Lamp, Readout, SceneKind, SimConfig};
 use serde_json::Value;
@@ -182,12 +183,7 @@ impl SimulateSettings {
             &self.output,
             Some(OutputFormat::Aedat4(self.events.compression)),
         )?;
-        let enf = self.enf_source();
-        if let EnfSource::Synthetic(grid) = enf {
-            if grid != 50.0 && grid != 60.0 {
-                return Err(rule("grid", format!("{} must be 50 or 60", option("grid"))));
-            }
-        }
+        let enf = self.enf_source()?;
         Ok(Recipe {
             config: self.config()?,
             enf,
@@ -242,9 +238,9 @@ impl SimulateSettings {
 
     /// The ENF source named by `enf` (`synthetic`, or PATH[:START]: a colon followed by a
     /// number is the start second).
-    fn enf_source(&self) -> EnfSource {
+    fn enf_source(&self) -> Result<EnfSource, OptionError> {
         if self.enf == "synthetic" {
-            return EnfSource::Synthetic(self.grid as f64);
+            return Ok(EnfSource::Synthetic(grid_of(self.grid)?));
         }
         let (path, offset_s) = match self.enf.rsplit_once(':') {
             Some((p, s)) => match s.parse::<f64>() {
@@ -253,11 +249,11 @@ impl SimulateSettings {
             },
             None => (PathBuf::from(&self.enf), 0.0),
         };
-        EnfSource::File {
+        Ok(EnfSource::File {
             path,
             offset_s,
             index_step_s: self.index_step,
-        }
+        })
     }
 }
 
@@ -432,7 +428,7 @@ impl DatasetSettings {
             enf: match &self.enf_dir {
                 Some(dir) => DatasetEnf::WavDir(dir.clone()),
                 None => DatasetEnf::Synthetic {
-                    grid_hz: self.grid as f64,
+                    grid: grid_of(self.grid)?,
                     from_local_s: parse_local_hour(&self.start)?,
                 },
             },
@@ -441,4 +437,10 @@ impl DatasetSettings {
             mp4: self.video.mp4,
         })
     }
+}
+
+/// The grid the option `grid` names: 50 or 60.
+fn grid_of(hz: u32) -> Result<Grid, OptionError> {
+    Grid::of_hz(f64::from(hz))
+        .ok_or_else(|| rule("grid", format!("{} must be 50 or 60", option("grid"))))
 }

@@ -433,7 +433,7 @@ impl StoreInputSettings {
                 zone: None,
                 unit: self.value_unit,
                 date_order: self.date_order,
-                nominal_hz: self.nominal.hz(),
+                grid: self.nominal.grid(),
             },
             start,
             index_step_s: self.index_step,

@@ -17,6 +17,7 @@ mod unit_dataset;
 mod unit_errors;
 mod unit_evaluate;
 mod unit_flac_mask;
+mod unit_grid;
 mod unit_output;
 mod unit_progress;
 mod unit_refdb;

@@ -79,7 +79,12 @@ fn a_hum_at_four_f0_in_real_room_noise_follows_the_mains_reference() {
     for (hour, offset) in [(0usize, 0usize), (2, 1800), (5, 1800)] {
         // the ENF of a real mains hour, per second, from `offset` on
         let wav = &common::reference_wavs()[hour];
-        let reference = reference_file(wav, Nominal::Hz(50.0), &EnfParams::default()).unwrap();
+        let reference = reference_file(
+            wav,
+            Nominal::Grid(eenf_core::Grid::Hz50),
+            &EnfParams::default(),
+        )
+        .unwrap();
         let enf = &reference.enf_hz[offset..offset + secs as usize + 4];
         let phase = MainsPhase::from_frequency(50.0, enf, 1.0, 0.0, secs, 0.3);
         let at = |k: f64| -> Vec<f64> {

@@ -70,9 +70,13 @@ fn six_real_hours_match_the_datasets_own_references() {
         assert!(share >= 0.995, "{}: only {share}", wav.display());
         // the exact refinement differs from the paper's by the interpolation bias: about a
         // millisecond-hertz on average, a few at worst where the ENF moves within the window
-        let exact = reference_file(wav, Nominal::Hz(50.0), &EnfParams::default())
-            .unwrap()
-            .enf_hz;
+        let exact = reference_file(
+            wav,
+            Nominal::Grid(eenf_core::Grid::Hz50),
+            &EnfParams::default(),
+        )
+        .unwrap()
+        .enf_hz;
         let diffs: Vec<f64> = exact
             .iter()
             .zip(&trace)
@@ -123,9 +127,13 @@ fn simulation_driven_by_a_real_hour_is_recovered() {
     println!("vs truth: {m:?}");
     assert!(m.n >= 120 && m.cc >= 0.95 && m.mae_hz <= 0.002, "{m:?}");
     // and against the real hour's own reference trace, 600 s in
-    let reference = reference_file(&wav, Nominal::Hz(50.0), &EnfParams::default())
-        .unwrap()
-        .enf_hz;
+    let reference = reference_file(
+        &wav,
+        Nominal::Grid(eenf_core::Grid::Hz50),
+        &EnfParams::default(),
+    )
+    .unwrap()
+    .enf_hz;
     let m = eenf_dsp::agreement(&x.enf_hz, &reference[600..]).unwrap();
     println!("vs the WAV's reference at 600 s: {m:?}");
     assert!(m.cc >= 0.95 && m.mae_hz <= 0.002, "{m:?}");

@@ -27,7 +27,12 @@ fn trace_csv_round_trip() {
 #[test]
 fn json_round_trip_keeps_provenance() {
     let params = EnfParams::default();
-    let t = Trace::from_mains(Path::new("m.wav"), 50.0, &params, vec![50.01, f64::NAN]);
+    let t = Trace::from_mains(
+        Path::new("m.wav"),
+        eenf_core::Grid::Hz50,
+        &params,
+        vec![50.01, f64::NAN],
+    );
     let mut buf = Vec::new();
     t.write_json(&mut buf).unwrap();
     let back = Trace::parse(std::str::from_utf8(&buf).unwrap(), Path::new("x"), None).unwrap();
