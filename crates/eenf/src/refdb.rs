@@ -16,6 +16,8 @@ use eenf_core::spelling::switch;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
+use eenf_core::Grid;
+
 use crate::error::{fail, Context, Result};
 
 use crate::output::write_atomic;
@@ -144,12 +146,12 @@ fn crc_of(bytes: &[u8]) -> u32 {
 }
 
 impl StoredGrid {
-    /// An empty series.
-    pub fn new(grid: &str, nominal_hz: f64, step_s: f64, start_unix_s: f64) -> Self {
+    /// An empty series named `name`, of the grid `grid`.
+    pub fn new(name: &str, grid: Grid, step_s: f64, start_unix_s: f64) -> Self {
         StoredGrid {
             meta: RefMeta {
-                grid: grid.to_string(),
-                nominal_hz,
+                grid: name.to_string(),
+                nominal_hz: grid.hz(),
                 step_s,
                 start_unix_s,
                 count: 0,

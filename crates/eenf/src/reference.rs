@@ -330,7 +330,7 @@ impl ReferenceSeries {
             // a folder of hourly WAVs, assembled in memory
             let files = hourly_references(path)?;
             let bar = progress.steps(files.len() as u64, "tracking the references");
-            let mut series = StoredGrid::new("folder", nominal, 1.0, 0.0);
+            let mut series = StoredGrid::new("folder", grid, 1.0, 0.0);
             for (_, f) in &files {
                 let trace = reference_file(f, Nominal::Auto, &EnfParams::default())?;
                 if trace.nominal_hz == Some(nominal) {
@@ -536,7 +536,7 @@ pub fn build_store(
                 let s = if store.join(format!("{grid}.json")).exists() {
                     StoredGrid::load(store, &grid)?
                 } else {
-                    StoredGrid::new(&grid, f0.hz(), step, start)
+                    StoredGrid::new(&grid, f0, step, start)
                 };
                 series.push(s);
                 series.len() - 1

@@ -6,7 +6,7 @@ use eenf::refdb::*;
 #[test]
 fn series_merge_round_trip() {
     let dir = tempfile::tempdir().unwrap();
-    let mut s = StoredGrid::new("g", 50.0, 1.0, 0.0);
+    let mut s = StoredGrid::new("g", eenf_core::Grid::Hz50, 1.0, 0.0);
     s.merge(100.0, 1.0, &[50.01, 49.99, f64::NAN]).unwrap();
     s.merge(110.0, 2.0, &[50.0, 50.002]).unwrap(); // resampled to 1 s: 3 values
     s.merge(98.0, 1.0, &[50.003]).unwrap(); // before the start: prepends a gap
@@ -28,7 +28,7 @@ fn series_merge_round_trip() {
 fn commits_replace_values_files_and_damage_is_found() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let mut s = StoredGrid::new("grid50", 50.0, 1.0, 1000.0);
+    let mut s = StoredGrid::new("grid50", eenf_core::Grid::Hz50, 1.0, 1000.0);
     s.merge(1000.0, 1.0, &[50.01, 49.99, 50.0]).unwrap();
     s.save(d).unwrap();
     let first = s.meta.values_file.clone().unwrap();
