@@ -274,7 +274,8 @@ fn preset(name: &str) -> Result<(Classes, f64, (u16, u16))> {
                     "{} {other:?}: expected ev-enfd, small or lamp-spot",
                     option("preset")
                 ),
-            ))
+            )
+            .into())
         }
     };
     let mut plans = cycle("static", n[0], &[&[Static]]);
@@ -297,7 +298,8 @@ pub fn plan_dataset(
         return Err(rule(
             "duration",
             format!("{} must be between 20 and 3600 s", option("duration")),
-        ));
+        )
+        .into());
     }
     let (width, height) = spec.resolution.unwrap_or(preset_res);
     let (lo, hi) = (from.ceil() as i64 + 30, (to - duration).floor() as i64 - 30);

@@ -69,7 +69,7 @@ pub struct DatasetBuilt {
 }
 
 /// Local seconds of a local date and hour like `2022-08-17T16` (minutes, if any, ignored).
-pub fn parse_local_hour(s: &str) -> Result<i64> {
+pub fn parse_local_hour(s: &str) -> Result<i64, crate::error::OptionError> {
     let bad = || {
         rule(
             "start",
@@ -83,7 +83,7 @@ pub fn parse_local_hour(s: &str) -> Result<i64> {
     let d: Vec<i16> = date
         .split('-')
         .map(|p| p.parse().map_err(|_| bad()))
-        .collect::<Result<_>>()?;
+        .collect::<Result<_, _>>()?;
     let h: i8 = hour
         .split(':')
         .next()

@@ -241,9 +241,12 @@ impl OptionError {
     }
 }
 
-/// An option's rule broken, in words: `name` is the option's library name.
-pub(crate) fn rule(name: &'static str, words: String) -> Error {
-    Error::Option(OptionError::Rule { name, rule: words })
+/// A broken rule about option `name` (its library name), in words.
+pub(crate) fn rule(name: &'static str, rule: impl Into<String>) -> OptionError {
+    OptionError::Rule {
+        name,
+        rule: rule.into(),
+    }
 }
 
 macro_rules! other_causes {

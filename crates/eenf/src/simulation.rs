@@ -376,7 +376,10 @@ pub fn write_recording(
 
 /// Parses `lr,hr` into camera presets, scaled by `scale` (0 < scale ≤ 1); `hr@0.125` gives a
 /// camera its own scale.
-pub fn parse_cameras(list: &str, scale: f64) -> Result<Vec<eenf_sim::CameraConfig>> {
+pub fn parse_cameras(
+    list: &str,
+    scale: f64,
+) -> Result<Vec<eenf_sim::CameraConfig>, crate::error::OptionError> {
     list.split(',')
         .filter(|s| !s.trim().is_empty())
         .map(|item| {

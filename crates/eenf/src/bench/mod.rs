@@ -63,10 +63,7 @@ impl Method {
             }
         }
         if out.is_empty() {
-            return Err(rule(
-                "methods",
-                format!("{}: no method given", option("methods")),
-            ));
+            return Err(rule("methods", format!("{}: no method given", option("methods"))).into());
         }
         out.sort_by_key(|m| Method::ALL.iter().position(|a| a == m));
         Ok(out)

@@ -69,14 +69,14 @@ impl Settings {
                 self.extract.flicker_tiles = match value {
                     "flicker" => true,
                     "all" => false,
-                    _ => return Err(bad()),
+                    _ => return Err(bad().into()),
                 }
             }
             "segment" => p.segment_len = value.parse().ok().filter(|s| *s >= 1).ok_or_else(bad)?,
             "median-len" => p.median_len = value.parse().map_err(|_| bad())?,
             "scene-removal" => self.video.scene_removal = value.parse().map_err(|_| bad())?,
             "video-sampling" => self.video.sampling = value.parse().map_err(|_| bad())?,
-            _ => return Err(rule("sweep", format!("{} {key}: unknown setting (harmonics, sampling, peak, window, dt-us, selection, tiles, segment, median-len, scene-removal, video-sampling)", option("sweep")))),
+            _ => return Err(rule("sweep", format!("{} {key}: unknown setting (harmonics, sampling, peak, window, dt-us, selection, tiles, segment, median-len, scene-removal, video-sampling)", option("sweep"))).into()),
         }
         self.label.push((key.to_string(), value.to_string()));
         Ok(())
@@ -97,10 +97,7 @@ pub fn sweep(base: &Settings, sweeps: &[String]) -> Result<Vec<Settings>> {
             .filter(|v| !v.is_empty())
             .collect();
         if values.is_empty() {
-            return Err(rule(
-                "sweep",
-                format!("{} {s:?}: no values", option("sweep")),
-            ));
+            return Err(rule("sweep", format!("{} {s:?}: no values", option("sweep"))).into());
         }
         let mut next = Vec::new();
         for settings in &out {

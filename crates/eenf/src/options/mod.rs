@@ -21,6 +21,7 @@ use std::str::FromStr;
 
 use serde_json::Value;
 
+pub(crate) use crate::error::rule;
 pub use crate::error::OptionError;
 pub use events::{EventOutputSettings, ExtractSettings, InputSettings, TrackerSettings};
 pub use simulate::{DatasetSettings, SimulateSettings, VideoRenderSettings};
@@ -159,14 +160,6 @@ fn outside(
         name,
         value: v.to_string(),
         reason: format!("{v} is outside {lo}..={hi}"),
-    }
-}
-
-/// A broken rule about option `name`.
-pub(crate) fn rule(name: &'static str, rule: impl Into<String>) -> OptionError {
-    OptionError::Rule {
-        name,
-        rule: rule.into(),
     }
 }
 

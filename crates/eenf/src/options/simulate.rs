@@ -55,8 +55,7 @@ impl VideoRenderSettings {
     /// The cameras asked for (none without `video`).
     pub fn cameras(&self) -> Result<Vec<eenf_sim::CameraConfig>, OptionError> {
         match &self.video {
-            Some(list) => crate::simulation::parse_cameras(list, self.video_scale)
-                .map_err(|e| rule("video", e.report())),
+            Some(list) => crate::simulation::parse_cameras(list, self.video_scale),
             None => Ok(Vec::new()),
         }
     }
