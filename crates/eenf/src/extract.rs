@@ -161,7 +161,15 @@ pub fn grid_line(path: &Path, open: &OpenOptions, grid: Grid) -> Result<Option<F
         &Progress::hidden(),
     )?;
     let lines = flicker_lines(&s.seq.signal(), s.seq.fs());
-    Ok(lines.map(|[a, b]| if grid == Grid::Hz60 { b } else { a }))
+    Ok(lines.map(|l| line_at(l, grid)))
+}
+
+/// Of the lines near 100 and 120 Hz (`flicker_lines`), the one of `grid`.
+fn line_at([fifty, sixty]: [FlickerLine; 2], grid: Grid) -> FlickerLine {
+    match grid {
+        Grid::Hz50 => fifty,
+        Grid::Hz60 => sixty,
+    }
 }
 
 /// Reads a recording into its flicker signal. A file with several cameras (a stereo pair,
@@ -288,7 +296,7 @@ fn decide_grid(
     let line = match (nominal, lines) {
         (_, None) => None,
         (Nominal::Auto, Some([a, b])) => Some(if a.prominence >= b.prominence { a } else { b }),
-        (Nominal::Grid(g), Some([a, b])) => Some(if g == Grid::Hz50 { a } else { b }),
+        (Nominal::Grid(g), Some(l)) => Some(line_at(l, g)),
     };
     let f0 = match (nominal, line) {
         (Nominal::Auto, Some(l)) if l.is_mains() => l.grid_hz,
