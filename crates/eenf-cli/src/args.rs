@@ -403,9 +403,11 @@ pub struct VideoMethodArgs {
     /// Virtual rows per frame period (real plus idle), if known.
     #[arg(long, conflicts_with = "idle", value_parser = number_in(limits::VIRTUAL_ROWS))]
     pub virtual_rows: Option<f64>,
-    /// Row sampling: zero-pad (idle rows as zeros), naive (rows concatenated), global (one
-    /// sample per frame, tracked at the alias of the flicker).
-    #[arg(long, default_value = "zero-pad", value_parser = one_of::<RowSampling>(&RowSampling::NAMES))]
+    /// Sampling: auto (rows zero-padded or frame means, whichever shows the flicker line
+    /// stronger; the trace says which and why), zero-pad (rows, idle rows as zeros), naive
+    /// (rows concatenated), global (one sample per frame: a global shutter, or frame means
+    /// only; the flicker is seen at its alias and tracked where the alias leaves it room).
+    #[arg(long, default_value = "auto", value_parser = one_of::<RowSampling>(&RowSampling::NAMES))]
     pub sampling: RowSampling,
     /// Scene removal: paper (each frame minus the mean of it and the next), row-mean (each
     /// row minus its mean over a second), none.

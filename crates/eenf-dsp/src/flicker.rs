@@ -143,3 +143,21 @@ pub fn flicker_lines(x: &[f64], fs: f64) -> Option<[FlickerLine; 2]> {
     };
     Some([line(BAND_50, 50.0), line(BAND_60, 60.0)])
 }
+
+/// A line's relative offset from where the grid puts it beyond which it is not the grid's
+/// doing: a grid strays by a few hundredths of a hertz, 0.1 % is 50 mHz at 50 Hz.
+pub const CLOCK_NOTE_OFFSET: f64 = 1e-3;
+
+/// What to tell the user when a flicker line measured at `line_hz` sits further from
+/// `expected_hz` (twice the grid) than a grid strays: the camera's clock, which times the
+/// samples, is off by that share, and so is every estimate.
+pub fn clock_offset_note(line_hz: f64, expected_hz: f64) -> Option<String> {
+    let offset = line_hz / expected_hz - 1.0;
+    (offset.abs() > CLOCK_NOTE_OFFSET).then(|| {
+        format!(
+            "the flicker line is at {line_hz:.3} Hz, {:.2} % {} {expected_hz} Hz: the camera's clock (or the grid) is off by that much; the trace is reported as measured",
+            100.0 * offset.abs(),
+            if offset < 0.0 { "below" } else { "above" },
+        )
+    })
+}

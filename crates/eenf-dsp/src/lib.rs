@@ -45,7 +45,8 @@ pub use enf::{
 };
 pub use filtfilt::sosfiltfilt;
 pub use flicker::{
-    flicker_line, flicker_lines, line_strength_at, FlickerLine, MIN_FLICKER_PROMINENCE,
+    clock_offset_note, flicker_line, flicker_lines, line_strength_at, FlickerLine,
+    MIN_FLICKER_PROMINENCE,
 };
 pub use hum::{
     check_holds_line, choose_window, plausibility, search_hum, HumLine, HumSearch, HumVerdict,

@@ -24,8 +24,9 @@ mod venf;
 
 pub use source::{FfmpegSource, FrameSource, VideoInfo, Y4mSource, Y4mWriter, MAX_FRAME_BYTES};
 pub use venf::{
-    estimate_virtual_rows, strongest_line, video_enf, video_enf_from_rows, IdleRows, RowMeans,
-    RowSampling, SceneRemoval, VideoAnalysis, VideoOptions,
+    estimate_virtual_rows, frame_alias, frame_half_band, strongest_line, video_enf,
+    video_enf_from_rows, IdleRows, RowMeans, RowSampling, SceneRemoval, VideoAnalysis,
+    VideoOptions,
 };
 
 /// Why a video could not be read or traced.

@@ -51,6 +51,15 @@ impl FrameSource {
         }
     }
 
+    /// Each frame's start, s from the first, when the container's frames are not evenly
+    /// spaced (a variable frame rate); `None` when they are `1/fps` apart (Y4M always).
+    pub fn frame_times(&self) -> Option<&[f64]> {
+        match self {
+            FrameSource::Y4m(_) => None,
+            FrameSource::Ffmpeg(s) => s.frame_times.as_deref(),
+        }
+    }
+
     /// Size and rate.
     pub fn info(&self) -> VideoInfo {
         match self {
@@ -212,6 +221,7 @@ pub struct FfmpegSource {
     child: Child,
     stdout: ChildStdout,
     info: VideoInfo,
+    frame_times: Option<Vec<f64>>,
     frame: Vec<u8>,
     frames: u64,
 }
@@ -257,9 +267,16 @@ impl FfmpegSource {
         };
         let width: usize = field("width").and_then(|v| v.parse().ok()).unwrap_or(0);
         let height: usize = field("height").and_then(|v| v.parse().ok()).unwrap_or(0);
-        let fps = field("avg_frame_rate")
-            .and_then(rate)
-            .or_else(|| field("r_frame_rate").and_then(rate));
+        // the stream's own rate (r_frame_rate) where the average agrees with it: the average
+        // counts the last frame's duration or not, and is off by tens of ppm (30.00125 for a
+        // 30 fps MP4), which would move every estimate by as much
+        let fps = match (
+            field("r_frame_rate").and_then(rate),
+            field("avg_frame_rate").and_then(rate),
+        ) {
+            (Some(r), Some(a)) if (r / a - 1.0).abs() < 0.01 => Some(r),
+            (r, a) => a.or(r),
+        };
         let Some(fps) = fps.filter(|_| width > 0 && height > 0) else {
             return Err(VideoError::bad(path, "ffprobe finds no video stream"));
         };
@@ -269,10 +286,16 @@ impl FfmpegSource {
                 format!("frames of {width}x{height} are too large"),
             ));
         }
+        let frame_times = uneven_frame_times(&probe, path, fps);
         let tool = ffmpeg_program("ffmpeg");
-        let mut child = Command::new(&tool)
-            .args(["-v", "error", "-nostdin", "-i"])
-            .arg(path)
+        let mut command = Command::new(&tool);
+        command.args(["-v", "error", "-nostdin", "-i"]).arg(path);
+        if frame_times.is_some() {
+            // every frame once, as the container times it (not repeated or dropped to a
+            // constant rate)
+            command.args(["-fps_mode", "passthrough"]);
+        }
+        let mut child = command
             .args(["-map", "0:v:0", "-f", "rawvideo", "-pix_fmt", "gray", "-"])
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -283,7 +306,14 @@ impl FfmpegSource {
             path: path.to_path_buf(),
             child,
             stdout,
-            info: VideoInfo { width, height, fps },
+            info: VideoInfo {
+                width,
+                height,
+                fps: frame_times
+                    .as_ref()
+                    .map_or(fps, |t| mean_rate(t).unwrap_or(fps)),
+            },
+            frame_times,
             frame: vec![0; width * height],
             frames: 0,
         })
@@ -322,6 +352,66 @@ impl Drop for FfmpegSource {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// At most this many frame times are read from a container (a day at 120 fps).
+const MAX_FRAME_TIMES: usize = 10_368_000;
+
+/// The presentation times of the video stream's packets (`ffprobe`), sorted and counted from
+/// the first, when they are not evenly spaced at about `fps`; `None` when they are, or when
+/// the container gives no usable times (then frames are taken `1/fps` apart, as before).
+fn uneven_frame_times(probe: &str, path: &Path, fps: f64) -> Option<Vec<f64>> {
+    let mut child = Command::new(probe)
+        .args(["-v", "error", "-select_streams", "v:0"])
+        .args(["-show_entries", "packet=pts_time", "-of", "csv=p=0"])
+        .arg(path)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .ok()?;
+    let stdout = child.stdout.take()?;
+    let mut times = Vec::new();
+    let mut usable = true;
+    for line in std::io::BufRead::lines(BufReader::new(stdout)) {
+        let Ok(line) = line else {
+            usable = false;
+            break;
+        };
+        match line.trim().trim_end_matches(',').parse::<f64>() {
+            Ok(t) if t.is_finite() && times.len() < MAX_FRAME_TIMES => times.push(t),
+            _ => {
+                usable = false;
+                break;
+            }
+        }
+    }
+    let _ = child.kill();
+    let ok = child.wait().is_ok_and(|s| s.success());
+    if !(usable && ok) || times.len() < 3 {
+        return None;
+    }
+    times.sort_by(f64::total_cmp);
+    let first = times[0];
+    for t in &mut times {
+        *t -= first;
+    }
+    let n = times.len();
+    // a span that the frames cannot fill (a wild timestamp) says nothing reliable
+    let span = times[n - 1];
+    if span.is_nan() || span <= 0.0 || span > 4.0 * n as f64 / fps {
+        return None;
+    }
+    // even: every step within a tenth of a frame of 1/fps (a container's tick rounds each)
+    let even = times
+        .windows(2)
+        .all(|w| ((w[1] - w[0]) * fps - 1.0).abs() < 0.1);
+    (!even).then_some(times)
+}
+
+/// Frames per second over `times` (frame starts), from the first to the last.
+fn mean_rate(times: &[f64]) -> Option<f64> {
+    let span = times.last()? - times.first()?;
+    (span > 0.0).then(|| (times.len() - 1) as f64 / span)
 }
 
 /// Writes 8-bit gray frames as a Y4M file (`C mono`), which ffmpeg and most tools read.

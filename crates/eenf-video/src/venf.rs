@@ -3,6 +3,7 @@
 //! per second, with an idle gap between frames.
 
 use eenf_dsp::enf::{line_prominence, MIN_PROMINENCE};
+use eenf_dsp::flicker::clock_offset_note;
 use eenf_dsp::{butter_bandpass, median_correct, sosfiltfilt, EnfParams, StftTracker};
 
 use crate::source::{FrameSource, VideoInfo};
@@ -44,12 +45,13 @@ impl std::str::FromStr for SceneRemoval {
 
 impl RowSampling {
     /// Every variant, by its command-line name.
-    pub const NAMES: [&'static str; 3] = ["zero-pad", "naive", "global"];
+    pub const NAMES: [&'static str; 4] = ["auto", "zero-pad", "naive", "global"];
 }
 
 impl std::fmt::Display for RowSampling {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
+            RowSampling::Auto(_) => "auto",
             RowSampling::ZeroPad(_) => "zero-pad",
             RowSampling::Naive => "naive",
             RowSampling::Global => "global",
@@ -57,15 +59,16 @@ impl std::fmt::Display for RowSampling {
     }
 }
 
-/// `zero-pad` estimates its idle rows ([`IdleRows::Auto`]).
+/// `zero-pad` and `auto` estimate their idle rows ([`IdleRows::Auto`]).
 impl std::str::FromStr for RowSampling {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
+            "auto" => Ok(RowSampling::Auto(IdleRows::Auto)),
             "zero-pad" => Ok(RowSampling::ZeroPad(IdleRows::Auto)),
             "naive" => Ok(RowSampling::Naive),
             "global" => Ok(RowSampling::Global),
-            _ => Err(format!("{s:?}: expected zero-pad, naive or global")),
+            _ => Err(format!("{s:?}: expected auto, zero-pad, naive or global")),
         }
     }
 }
@@ -77,8 +80,39 @@ pub enum RowSampling {
     Naive,
     /// Each frame padded with zeros for its idle rows: `L` virtual rows per frame, fs = L·fps.
     ZeroPad(IdleRows),
-    /// One sample per frame (a global shutter): the flicker is tracked at its alias.
+    /// One sample per frame (a global shutter, or frame means only): the flicker line is seen
+    /// at its alias |2f0 − k·fps|, and tracked where the alias leaves it room.
     Global,
+    /// Rows zero-padded (with these idle rows) or frames, whichever shows the flicker line
+    /// stronger.
+    Auto(IdleRows),
+}
+
+impl RowSampling {
+    /// The idle rows this sampling zero-pads with, if it does.
+    pub fn idle_rows(self) -> Option<IdleRows> {
+        match self {
+            RowSampling::ZeroPad(i) | RowSampling::Auto(i) => Some(i),
+            _ => None,
+        }
+    }
+
+    /// `Auto` taken as rows (`ZeroPad`); any other sampling as it is.
+    pub fn resolved(self) -> Self {
+        match self {
+            RowSampling::Auto(i) => RowSampling::ZeroPad(i),
+            other => other,
+        }
+    }
+
+    /// This sampling with its idle rows set to `idle` (where it has any).
+    pub fn with_idle_rows(self, idle: IdleRows) -> Self {
+        match self {
+            RowSampling::ZeroPad(_) => RowSampling::ZeroPad(idle),
+            RowSampling::Auto(_) => RowSampling::Auto(idle),
+            other => other,
+        }
+    }
 }
 
 /// How many virtual rows (real plus idle) one frame period holds.
@@ -109,7 +143,7 @@ impl Default for VideoOptions {
     fn default() -> Self {
         VideoOptions {
             nominal_hz: None,
-            sampling: RowSampling::ZeroPad(IdleRows::Auto),
+            sampling: RowSampling::Auto(IdleRows::Auto),
             scene_removal: SceneRemoval::Paper,
             params: EnfParams::default(),
         }
@@ -123,12 +157,24 @@ pub struct RowMeans {
     pub info: VideoInfo,
     /// `values[n * rows + i]`: mean of row i of frame n.
     pub values: Vec<f64>,
+    /// Start of each frame, s from the first, when the container's frames are not evenly
+    /// spaced (variable frame rate); `None` for frames `1/fps` apart.
+    pub frame_times: Option<Vec<f64>>,
 }
 
 impl RowMeans {
     /// Number of frames.
     pub fn frames(&self) -> usize {
         self.values.len() / self.info.height.max(1)
+    }
+
+    /// Seconds from the first frame to the end of the last.
+    pub fn duration_s(&self) -> f64 {
+        let n = self.frames();
+        match &self.frame_times {
+            Some(t) if n > 0 => t[n - 1] + 1.0 / self.info.fps,
+            _ => n as f64 / self.info.fps,
+        }
     }
 
     /// Reads every frame of `source`; `progress` gets the frames read so far.
@@ -150,7 +196,21 @@ impl RowMeans {
             }
         }
         progress(n);
-        Ok(RowMeans { info, values })
+        // as many times as frames decoded: a frame the decoder lost drops its time, one
+        // without a time (a damaged index) follows the last at the mean rate
+        let frame_times = source.frame_times().map(|t| {
+            let n = n as usize;
+            let mut t = t[..t.len().min(n)].to_vec();
+            while t.len() < n {
+                t.push(t.last().map_or(0.0, |l| l + 1.0 / info.fps));
+            }
+            t
+        });
+        Ok(RowMeans {
+            info,
+            values,
+            frame_times,
+        })
     }
 
     /// The row means with the scene taken out.
@@ -186,9 +246,15 @@ impl RowMeans {
                 out
             }
         };
+        // the paper's difference of frames f and f + 1 sits at frame f's time
+        let frames = values.len() / h.max(1);
         RowMeans {
             info: self.info,
             values,
+            frame_times: self
+                .frame_times
+                .as_ref()
+                .map(|t| t[..frames.min(t.len())].to_vec()),
         }
     }
 }
@@ -202,6 +268,12 @@ pub struct VideoAnalysis {
     pub enf_hz: Vec<f64>,
     /// Grid frequency used, Hz.
     pub nominal_hz: f64,
+    /// The sampling used (`auto` resolved to rows or frames).
+    pub sampling: RowSampling,
+    /// Why `auto` chose it (`None` when the sampling was given).
+    pub sampling_reason: Option<String>,
+    /// The scene removal used (`paper` becomes `row-mean` for frames timed by the container).
+    pub scene_removal: SceneRemoval,
     /// Sampling rate of the row signal, Hz.
     pub fs: f64,
     /// Virtual rows per frame (zero-padding), if used.
@@ -212,8 +284,12 @@ pub struct VideoAnalysis {
     pub prominence: f64,
     /// Frames read.
     pub frames: usize,
-    /// Video size and rate.
+    /// True when the frames' times came from the container (variable frame rate).
+    pub frame_times: bool,
+    /// Size and rate of the video.
     pub info: VideoInfo,
+    /// What the caller should be told: a camera clock that seems off.
+    pub warnings: Vec<String>,
 }
 
 /// Estimates the virtual rows per frame from the flicker's ripple down each frame: the L for
@@ -255,40 +331,155 @@ pub fn estimate_virtual_rows(rows: &RowMeans, nominal_hz: f64) -> f64 {
     best
 }
 
-/// The flicker line a sampling sees: 2f0 for rows, its alias |2f0 − k·fps| for one sample per
-/// frame; with the sign of the alias (−1 when it runs against the ENF) and k.
-fn line_for(sampling: RowSampling, nominal: f64, fps: f64) -> (f64, f64, f64) {
-    match sampling {
-        RowSampling::Global => {
-            let k = (2.0 * nominal / fps).round();
-            let a = 2.0 * nominal - k * fps;
-            (a.abs(), if a >= 0.0 { 1.0 } else { -1.0 }, k)
-        }
-        _ => (2.0 * nominal, 1.0, 0.0),
+/// How far a grid's ENF strays from nominal, Hz: on the flicker line (2f) twice as far.
+pub const ENF_REACH_HZ: f64 = 0.1;
+
+/// How far a camera's frame clock may be off, as a share: crystals are off by tens of ppm, and
+/// a file may state a rounded rate (29.97 for 30000/1001 is 1 ppm off).
+pub const CLOCK_TOLERANCE: f64 = 5e-4;
+
+/// Frame means are laid on a grid of at least this many samples per second, so that every
+/// grid's flicker line and the 6 Hz around it that [`line_prominence`] measures fit below its
+/// Nyquist frequency.
+const FRAME_SIGNAL_HZ: f64 = 1000.0;
+
+/// The alias of the flicker line `line_2f` in one sample per frame at `fps`: |2f − k·fps| with
+/// the k that brings it nearest 0.
+pub fn frame_alias(line_2f: f64, fps: f64) -> f64 {
+    (line_2f - (line_2f / fps).round() * fps).abs()
+}
+
+/// The share of its half band that a Butterworth band-pass of `order` passes flat (within
+/// 0.1 dB): |H|² = 1/(1 + Ω^2N) stays above 10^(−0.01) for Ω under (10^0.01 − 1)^(1/2N)
+/// (0.62 for order 4).
+fn flat_share(order: usize) -> f64 {
+    (10f64.powf(0.01) - 1.0).powf(1.0 / (2.0 * order.max(1) as f64))
+}
+
+/// The half band (Hz, around 2f0) the tracker can use when one sample per frame sees the
+/// flicker, or why there is none. One sample per frame folds the spectrum at 0 and at fps/2:
+/// the line's alias a has a mirror image 2m away, where m is its distance to the nearer fold.
+/// The band must keep the line flat over its reach e (the ENF's ±0.1 Hz, doubled on the
+/// flicker line, and a frame clock off by up to [`CLOCK_TOLERANCE`]) and the tracker
+/// window's main lobe (2/window Hz), and must end before the fold (so the mirror, which comes
+/// as close as 2(m − e), lies beyond the filter's edge).
+pub fn frame_half_band(nominal_hz: f64, fps: f64, p: &EnfParams) -> Result<f64, String> {
+    let line = 2.0 * nominal_hz;
+    let a = frame_alias(line, fps);
+    let fold = a.min(fps / 2.0 - a);
+    let reach = 2.0 * ENF_REACH_HZ + line * CLOCK_TOLERANCE;
+    let needed = (reach + 2.0 / p.window_s) / flat_share(p.filter_order);
+    let half_band = p.half_band_hz.min(fold - reach);
+    if half_band < needed {
+        let (edge, at) = if a < fps / 4.0 {
+            ("0", "above")
+        } else {
+            ("the Nyquist frequency", "below")
+        };
+        return Err(format!(
+            "at {fps:.3} fps the {line:.0} Hz flicker aliases to {a:.2} Hz, {fold:.2} Hz {at} {edge}: too close to track (its band needs {needed:.2} Hz each side: the ENF's reach ±{reach:.2} Hz on the line and the {} s window's resolution)",
+            p.window_s
+        ));
     }
+    Ok(half_band)
+}
+
+/// Lays frames of `h` values each on a uniform grid of `l` ≥ `h` slots per frame period (the
+/// rest zeros): frame f at f·l, or at its time from the container. The signal and its rate.
+fn place(values: &[f64], h: usize, l: usize, fps: f64, times: Option<&[f64]>) -> (Vec<f64>, f64) {
+    let fs = l as f64 * fps;
+    let n = values.len() / h.max(1);
+    let starts: Vec<usize> = match times {
+        None => (0..n).map(|f| f * l).collect(),
+        Some(t) => {
+            let mut next = 0usize;
+            t[..n]
+                .iter()
+                .map(|&s| {
+                    let at = ((s * fs).round().max(0.0) as usize).max(next);
+                    next = at + h;
+                    at
+                })
+                .collect()
+        }
+    };
+    let mut x = vec![0.0; starts.last().map_or(0, |&s| s + l)];
+    for (f, &s) in starts.iter().enumerate() {
+        x[s..s + h].copy_from_slice(&values[f * h..(f + 1) * h]);
+    }
+    (x, fs)
 }
 
 /// The row signal as one uniformly sampled sequence, and its rate.
 fn sample(rows: &RowMeans, sampling: RowSampling, virtual_rows: Option<f64>) -> (Vec<f64>, f64) {
     let (h, fps) = (rows.info.height, rows.info.fps);
     let n = rows.frames();
+    let times = rows.frame_times.as_deref();
     match sampling {
         RowSampling::Naive => (rows.values.clone(), h as f64 * fps),
-        RowSampling::Global => (
-            (0..n)
+        RowSampling::Global => {
+            // frame means as impulses: the flicker line stays at 2f, its alias's images
+            // at 2f ± j·fps
+            let means: Vec<f64> = (0..n)
                 .map(|f| rows.values[f * h..(f + 1) * h].iter().sum::<f64>() / h as f64)
-                .collect(),
-            fps,
-        ),
-        RowSampling::ZeroPad(_) => {
+                .collect();
+            let slots = (FRAME_SIGNAL_HZ / fps).ceil().max(1.0) as usize;
+            place(&means, 1, slots, fps, times)
+        }
+        RowSampling::ZeroPad(_) | RowSampling::Auto(_) => {
             let l = (virtual_rows.unwrap_or(h as f64).round() as usize).max(h);
-            let mut x = vec![0.0; n * l];
-            for f in 0..n {
-                x[f * l..f * l + h].copy_from_slice(&rows.values[f * h..(f + 1) * h]);
-            }
-            (x, l as f64 * fps)
+            place(&rows.values, h, l, fps, times)
         }
     }
+}
+
+/// One way of sampling one grid's flicker, measured.
+struct Candidate {
+    nominal: f64,
+    sampling: RowSampling,
+    virtual_rows: Option<f64>,
+    /// The signal, its rate and the half band around 2f0 it can be tracked in.
+    x: Vec<f64>,
+    fs: f64,
+    half_band: f64,
+    prominence: f64,
+}
+
+/// Samples `rows` for the `nominal` grid's flicker with `sampling`, or says why it cannot.
+fn candidate(
+    rows: &RowMeans,
+    nominal: f64,
+    sampling: RowSampling,
+    p: &EnfParams,
+) -> Result<Candidate, String> {
+    let info = rows.info;
+    let line = 2.0 * nominal;
+    let half_band = match sampling {
+        RowSampling::Global => frame_half_band(nominal, info.fps, p)?,
+        _ => p.half_band_hz,
+    };
+    let virtual_rows = match sampling.idle_rows() {
+        Some(IdleRows::VirtualRows(l)) => Some(l),
+        Some(IdleRows::ReadoutS(r)) => Some(info.height as f64 / (r * info.fps)),
+        Some(IdleRows::Auto) => Some(estimate_virtual_rows(rows, nominal)),
+        None => None,
+    };
+    let (x, fs) = sample(rows, sampling, virtual_rows);
+    if line + half_band + 6.0 >= fs / 2.0 {
+        return Err(format!(
+            "rows sampled at {fs:.0} Hz leave no room for the {line:.0} Hz flicker"
+        ));
+    }
+    let prominence = line_prominence(&x, fs, line);
+    Ok(Candidate {
+        nominal,
+        sampling: sampling.resolved(),
+        virtual_rows,
+        x,
+        fs,
+        half_band,
+        prominence,
+    })
 }
 
 /// V-ENF on row means already read (see [`RowMeans::read`]).
@@ -298,93 +489,156 @@ pub fn video_enf_from_rows(
 ) -> Result<VideoAnalysis, VideoError> {
     let info = raw.info;
     let p = &opts.params;
-    let duration = raw.frames() as f64 / info.fps;
+    let duration = raw.duration_s();
     if duration < p.window_s {
         return Err(VideoError::Signal(format!(
             "the video lasts {duration:.2} s, shorter than one {} s analysis window",
             p.window_s
         )));
     }
-    let rows = raw.without_scene(opts.scene_removal);
+    // the paper's removal differences consecutive frames, which at uneven spacing mixes the
+    // flicker's phases: frames timed by the container have each row's running mean taken out
+    let removal = match (opts.scene_removal, &raw.frame_times) {
+        (SceneRemoval::Paper, Some(_)) => SceneRemoval::RowMean,
+        (how, _) => how,
+    };
+    let rows = raw.without_scene(removal);
     let nominals: Vec<f64> = match opts.nominal_hz {
         Some(f) => vec![f],
         None => vec![50.0, 60.0],
     };
-    // for each candidate grid: the virtual rows, the signal and how its line stands out
-    // (grid, virtual rows, signal, rate, prominence)
-    type Candidate = (f64, Option<f64>, Vec<f64>, f64, f64);
-    let mut best: Option<Candidate> = None;
-    for &nominal in &nominals {
-        let virtual_rows = match opts.sampling {
-            RowSampling::ZeroPad(IdleRows::VirtualRows(l)) => Some(l),
-            RowSampling::ZeroPad(IdleRows::ReadoutS(r)) => {
-                Some(info.height as f64 / (r * info.fps))
-            }
-            RowSampling::ZeroPad(IdleRows::Auto) => Some(estimate_virtual_rows(&rows, nominal)),
-            _ => None,
-        };
-        let (x, fs) = sample(&rows, opts.sampling, virtual_rows);
-        let (line, _, _) = line_for(opts.sampling, nominal, info.fps);
-        if line < p.half_band_hz + 0.5 || line + p.half_band_hz + 6.0 >= fs / 2.0 {
-            if opts.nominal_hz.is_some() {
-                return Err(VideoError::Signal(format!(
-                    "at {:.3} fps the {:.0} Hz flicker aliases to {line:.2} Hz, too close to 0 or to the Nyquist frequency to track",
-                    info.fps,
-                    2.0 * nominal
-                )));
-            }
-            continue;
-        }
-        let prom = line_prominence(&x, fs, line);
-        if best.as_ref().is_none_or(|b| prom > b.4) {
-            best = Some((nominal, virtual_rows, x, fs, prom));
-        }
-    }
-    let Some((nominal, virtual_rows, x, fs, prominence)) = best else {
-        return Err(VideoError::Signal(format!(
-            "at {:.3} fps neither a 50 nor a 60 Hz grid's flicker can be tracked",
-            info.fps
-        )));
+    let samplings = match opts.sampling {
+        RowSampling::Auto(idle) => vec![RowSampling::ZeroPad(idle), RowSampling::Global],
+        s => vec![s],
     };
-    let (line, sign, k) = line_for(opts.sampling, nominal, info.fps);
-    if prominence < MIN_PROMINENCE {
+    // every (grid, sampling) measured; the strongest line kept
+    let mut best: Option<Candidate> = None;
+    let mut tried: Vec<(f64, RowSampling, Result<f64, String>)> = Vec::new();
+    for &nominal in &nominals {
+        for &sampling in &samplings {
+            let c = candidate(&rows, nominal, sampling, p);
+            tried.push((
+                nominal,
+                sampling.resolved(),
+                c.as_ref().map(|c| c.prominence).map_err(Clone::clone),
+            ));
+            if let Ok(c) = c {
+                if best.as_ref().is_none_or(|b| c.prominence > b.prominence) {
+                    best = Some(c);
+                }
+            }
+        }
+    }
+    let refused: Vec<&str> = tried
+        .iter()
+        .filter_map(|t| t.2.as_ref().err())
+        .map(String::as_str)
+        .collect();
+    let Some(c) = best else {
+        return Err(VideoError::Signal(if refused.len() == 1 {
+            refused[0].to_string()
+        } else {
+            format!(
+                "at {:.3} fps neither a 50 nor a 60 Hz grid's flicker can be tracked ({})",
+                info.fps,
+                refused.join("; ")
+            )
+        }));
+    };
+    let line_2f = 2.0 * c.nominal;
+    let line = match c.sampling {
+        RowSampling::Global => frame_alias(line_2f, info.fps),
+        _ => line_2f,
+    };
+    if c.prominence < MIN_PROMINENCE {
+        let also = if refused.is_empty() {
+            String::new()
+        } else {
+            format!("; {}", refused.join("; "))
+        };
         return Err(VideoError::Signal(format!(
-            "no flicker in the video: the line at {line:.2} Hz ({nominal} Hz grid) stands only {prominence:.1}x above the noise, {MIN_PROMINENCE}x needed"
+            "no flicker in the video: the line at {line:.2} Hz ({} Hz grid) stands only {:.1}x above the noise, {MIN_PROMINENCE}x needed{also}",
+            c.nominal, c.prominence
         )));
     }
-    // band-pass at the line, then keep every D-th sample (nothing is left to alias) so the
+    let sampling_reason = (samplings.len() > 1).then(|| auto_reason(&c, &tried));
+    // band-pass at 2f0, then keep every D-th sample (nothing is left to alias) so the
     // tracker works at about 1 kHz
-    let band = (line - p.half_band_hz, line + p.half_band_hz);
-    let sos = butter_bandpass(p.filter_order, band.0, band.1, fs);
-    let y = sosfiltfilt(&sos, &x);
-    let d = ((fs / (8.0 * band.1).max(1000.0)).floor() as usize).max(1);
+    let band = (line_2f - c.half_band, line_2f + c.half_band);
+    let sos = butter_bandpass(p.filter_order, band.0, band.1, c.fs);
+    let y = sosfiltfilt(&sos, &c.x);
+    drop(c.x);
+    let d = ((c.fs / (8.0 * band.1).max(1000.0)).floor() as usize).max(1);
     let yd: Vec<f64> = y.iter().step_by(d).copied().collect();
     let tracker = StftTracker {
-        fs: fs / d as f64,
+        fs: c.fs / d as f64,
         window_s: p.window_s,
         step_s: p.step_s,
         peak: p.peak,
         paper_bin_hz: p.paper_bin_hz,
     };
-    let raw_line = tracker.track(&yd, band);
-    // back to the 2f scale, outliers corrected there, then halved
-    let on_2f: Vec<f64> = raw_line.iter().map(|&a| k * info.fps + sign * a).collect();
+    let on_2f = tracker.track(&yd, band);
+    // outliers corrected on the 2f scale, then halved
     let corrected = if p.median_len > 1 {
         median_correct(&on_2f, p.median_len, p.median_threshold_hz)
     } else {
         on_2f
     };
+    let enf_hz: Vec<f64> = corrected.iter().map(|f| f / 2.0).collect();
+    let warnings = clock_offset_note(2.0 * mean_of(&enf_hz), line_2f)
+        .into_iter()
+        .collect();
     Ok(VideoAnalysis {
         step_s: p.step_s,
-        enf_hz: corrected.iter().map(|f| f / 2.0).collect(),
-        nominal_hz: nominal,
-        fs,
-        virtual_rows,
+        enf_hz,
+        nominal_hz: c.nominal,
+        sampling: c.sampling,
+        sampling_reason,
+        scene_removal: removal,
+        fs: c.fs,
+        virtual_rows: c.virtual_rows,
         line_hz: line,
-        prominence,
+        prominence: c.prominence,
         frames: raw.frames(),
+        frame_times: raw.frame_times.is_some(),
         info,
+        warnings,
     })
+}
+
+/// The mean of the finite values (NaN when there is none).
+fn mean_of(x: &[f64]) -> f64 {
+    let (s, n) = x
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 {
+        f64::NAN
+    } else {
+        s / n as f64
+    }
+}
+
+/// Why `auto` sampled by rows or by frames: the line's height both ways on the chosen grid.
+fn auto_reason(chosen: &Candidate, tried: &[(f64, RowSampling, Result<f64, String>)]) -> String {
+    let by = |s: RowSampling| match s {
+        RowSampling::Global => "frame means",
+        _ => "rows",
+    };
+    let other = tried
+        .iter()
+        .find(|t| t.0 == chosen.nominal && t.1 != chosen.sampling);
+    let rest = match other.map(|t| (t.1, &t.2)) {
+        Some((s, Ok(p))) => format!(", {p:.1}x in the {}", by(s)),
+        Some((s, Err(why))) => format!("; the {} cannot be used: {why}", by(s)),
+        None => String::new(),
+    };
+    format!(
+        "{}: the flicker line stands {:.1}x above the noise in the {}{rest}",
+        chosen.sampling,
+        chosen.prominence,
+        by(chosen.sampling)
+    )
 }
 
 /// V-ENF on a video: row means, scene removal, row sampling, band-pass at the flicker line,

@@ -5,9 +5,9 @@ use std::path::Path;
 
 use crate::error::{error, fail, Error, Result};
 use eenf_dsp::{
-    check_line, decimate, decimation_for, detect_nominal, enf_from_flicker, flicker_line,
-    flicker_lines, EnfParams, FlickerLine, Grouping, PolaritySequence, SamplingMethod,
-    TemporalSampler, MIN_FLICKER_PROMINENCE,
+    check_line, clock_offset_note, decimate, decimation_for, detect_nominal, enf_from_flicker,
+    flicker_line, flicker_lines, EnfParams, FlickerLine, Grouping, PolaritySequence,
+    SamplingMethod, TemporalSampler, MIN_FLICKER_PROMINENCE,
 };
 use eenf_events::{EventReader, OpenOptions, StreamInfo};
 
@@ -68,6 +68,10 @@ pub struct Sampled {
     pub notes: Vec<String>,
     /// What ended the stream before the file's end (damage, a wild timestamp).
     pub damage: Option<eenf_events::Damage>,
+    /// The recording's flicker lines near 100 and 120 Hz, measured one way wherever a line is
+    /// reported (`info`, `extract`, `flicker-map`): in the 1 ms ON − OFF sums of every event
+    /// read, whatever the sampling traced. `None` when shorter than a second.
+    pub lines: Option<[FlickerLine; 2]>,
 }
 
 /// Reads `rec` (as `open` says) into a flicker signal sampled with `sampling` every `dt_us`.
@@ -94,10 +98,15 @@ fn sample_reader(
     let info = reader.info().clone();
     let bar = progress.events(info.event_count, "reading events");
     let mut sampler = TemporalSampler::with_interval(sampling, dt_us);
+    // the line is measured on every event, whatever the tiles and the sampling
+    let mut measure = Some(TemporalSampler::new(SamplingMethod::Sum, 1000));
     let mut kept = eenf_events::EventBatch::default();
     let mut events = 0u64;
     while let Some(batch) = reader.next_batch()? {
         events += batch.len() as u64;
+        if measure.as_mut().is_some_and(|m| m.push(&batch).is_err()) {
+            measure = None;
+        }
         let batch = match mask {
             Some(m) => {
                 m.filter(&batch, &mut kept);
@@ -121,6 +130,9 @@ fn sample_reader(
     let seq = sampler
         .finish()
         .map_err(|e| Error::from(e).context(path.display()))?;
+    let lines = measure
+        .and_then(|m| m.finish().ok())
+        .and_then(|m| flicker_lines(&m.signal(), m.fs()));
     let mut notes = info.notes.clone();
     notes.extend(mask.map(TileMask::describe));
     Ok(Sampled {
@@ -130,6 +142,7 @@ fn sample_reader(
         events,
         seq,
         damage,
+        lines,
     })
 }
 
@@ -283,16 +296,16 @@ pub fn extract(rec: &Recording, opts: &ExtractOptions, progress: &Progress) -> R
     })
 }
 
-/// The grid of a flicker signal: decided from its strongest line near 100/120 Hz, or checked
-/// against `nominal`. Also returns the line, and a note when the line sits off twice the grid
+/// The grid of a flicker signal: decided from the recording's strongest line near 100/120 Hz
+/// (`lines`, see [`Sampled::lines`]), or checked against `nominal`. Also returns the line, and a note when the line sits off twice the grid
 /// by more than a grid wanders (a camera clock that runs off).
 fn decide_grid(
     x: &[f64],
     fs: f64,
+    lines: Option<[FlickerLine; 2]>,
     nominal: Nominal,
     harmonics: usize,
 ) -> std::result::Result<(f64, Option<FlickerLine>, Option<String>), eenf_dsp::DspError> {
-    let lines = flicker_lines(x, fs);
     let line = match (nominal, lines) {
         (_, None) => None,
         (Nominal::Auto, Some([a, b])) => Some(if a.prominence >= b.prominence { a } else { b }),
@@ -319,15 +332,9 @@ fn decide_grid(
             f
         }
     };
-    let note = line.filter(|l| l.is_mains() && l.offset.abs() > 1e-3).map(|l| {
-        format!(
-            "the flicker line is at {:.3} Hz, {:.2} % {} {} Hz: the camera's clock (or the grid) is off by that much; the trace is reported as measured",
-            l.hz,
-            100.0 * l.offset.abs(),
-            if l.offset < 0.0 { "below" } else { "above" },
-            2.0 * l.grid_hz
-        )
-    });
+    let note = line
+        .filter(|l| l.is_mains())
+        .and_then(|l| clock_offset_note(l.hz, 2.0 * l.grid_hz));
     Ok((f0, line, note))
 }
 
@@ -381,8 +388,11 @@ pub fn extract_sampled(
         ));
         params.window_s = window;
     }
-    let (f0, line, note) = decide_grid(&x, fs, opts.nominal, params.harmonics).map_err(err)?;
+    let (f0, line, note) =
+        decide_grid(&x, fs, s.lines, opts.nominal, params.harmonics).map_err(err)?;
     params.nominal_hz = f0;
+    // a clock that runs off is a warning as well as a note: every estimate is off by as much
+    let warnings: Vec<String> = note.iter().cloned().collect();
     notes.extend(note);
     let spin = progress.spinner("tracking the ENF");
     // the signal already converted above is tracked as it is (no second copy)
@@ -403,5 +413,7 @@ pub fn extract_sampled(
         notes,
         damage: s.damage.map(|d| d.to_string()),
     };
-    Ok(Trace::from_events(path, &estimates, provenance))
+    let mut trace = Trace::from_events(path, &estimates, provenance);
+    trace.warnings.extend(warnings);
+    Ok(trace)
 }

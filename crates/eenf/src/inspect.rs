@@ -15,10 +15,11 @@ use crate::recording::Recording;
 pub struct CameraFlicker {
     /// The camera, in a file with several.
     pub camera: Option<u8>,
-    /// Its strongest line near 100/120 Hz in the signal E-ENF samples (`auto` sampling;
-    /// `None`: shorter than a second, or no events).
+    /// Its strongest line near 100/120 Hz in the 1 ms ON − OFF sums, the one measure `info`,
+    /// `extract` and `flicker-map` report (and real recordings are calibrated with; `None`:
+    /// shorter than a second, or no events).
     pub line: Option<FlickerLine>,
-    /// The same in the 1 ms ON − OFF sums (the measure real recordings are calibrated with).
+    /// The same line (kept under this name for readers of earlier versions' JSON).
     pub sum_line: Option<FlickerLine>,
 }
 
@@ -47,7 +48,6 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
     let info = reader.info().clone();
     let mut stats = StreamStats::default();
     let mut sampler = TemporalSampler::new(SamplingMethod::Sum, 1000);
-    let mut auto = TemporalSampler::new(SamplingMethod::Auto, 1000);
     let mut grouping = None;
     let mut wild = false;
     while let Some(b) = reader.next_batch()? {
@@ -56,7 +56,7 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
             grouping = Some(Grouping::measure(&b.t));
         }
         // a wild timestamp ends the flicker analysis, not the statistics
-        wild = wild || sampler.push(&b).is_err() || auto.push(&b).is_err();
+        wild = wild || sampler.push(&b).is_err();
     }
     let skipped = reader.skipped();
     let damage = reader.damage().cloned();
@@ -68,18 +68,20 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
         // two clocks: each camera on its own
         let mut out = Vec::new();
         for c in 0..info.cameras.len().min(u8::MAX as usize) as u8 {
+            let line = camera_line(&rec, open, c, SamplingMethod::Sum)?;
             out.push(CameraFlicker {
                 camera: Some(c),
-                line: camera_line(&rec, open, c, SamplingMethod::Auto)?,
-                sum_line: camera_line(&rec, open, c, SamplingMethod::Sum)?,
+                line,
+                sum_line: line,
             });
         }
         out
     } else {
+        let line = if wild { None } else { line_of(sampler) };
         vec![CameraFlicker {
             camera: open.camera,
-            line: if wild { None } else { line_of(auto) },
-            sum_line: if wild { None } else { line_of(sampler) },
+            line,
+            sum_line: line,
         }]
     };
     Ok(Inspection {

@@ -101,8 +101,14 @@ pub struct VideoProvenance {
     pub fps: f64,
     /// Frames read.
     pub frames: usize,
-    /// Row sampling used.
+    /// Sampling used (`auto` resolved to `zero-pad` or `global`).
     pub sampling: RowSampling,
+    /// Why `auto` chose it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampling_reason: Option<String>,
+    /// True when the frames' times came from the container (a variable frame rate).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub frame_times: bool,
     /// Scene removal used.
     pub scene_removal: SceneRemoval,
     /// Rows per frame period (real and idle), when zero-padded.
@@ -313,14 +319,17 @@ impl Trace {
                 height: v.info.height,
                 fps: v.info.fps,
                 frames: v.frames,
-                sampling: opts.sampling,
-                scene_removal: opts.scene_removal,
+                sampling: v.sampling,
+                sampling_reason: v.sampling_reason.clone(),
+                frame_times: v.frame_times,
+                scene_removal: v.scene_removal,
                 virtual_rows: v.virtual_rows,
                 fs_hz: v.fs,
                 line_hz: v.line_hz,
                 prominence: v.prominence,
                 params: opts.params.clone(),
             })),
+            warnings: v.warnings.clone(),
             ..Trace::new(v.step_s, v.enf_hz.clone())
         }
     }

@@ -26,25 +26,16 @@ fn flicker_text(f: &CameraFlicker) -> String {
         .camera
         .map(|c| format!("camera {c}: "))
         .unwrap_or_default();
-    let sum = f
-        .sum_line
-        .map(|l| {
-            format!(
-                "; ON − OFF sums: {:.3} Hz, prominence {:.1}",
-                l.hz, l.prominence
-            )
-        })
-        .unwrap_or_default();
     match f.line {
         Some(l) if l.is_mains() => format!(
-            "{who}{:.3} Hz ({} Hz grid), {:.0} dB above the noise (prominence {:.1}{sum})",
+            "{who}{:.3} Hz ({} Hz grid), {:.0} dB above the noise (prominence {:.1}, in the 1 ms ON − OFF sums)",
             l.hz,
             l.grid_hz,
             l.db(),
             l.prominence
         ),
         Some(l) => format!(
-            "{who}none: the strongest line near 100/120 Hz, {:.3} Hz, stands {:.1}x above the noise{sum}",
+            "{who}none: the strongest line near 100/120 Hz, {:.3} Hz, stands {:.1}x above the noise",
             l.hz, l.prominence
         ),
         None => format!("{who}not measured (shorter than 1 s)"),

@@ -26,19 +26,31 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
     let trace = eenf::video::trace_video(&a.file, &opts, &progress)?;
     let took = started.elapsed().as_secs_f64();
     a.out.save(&trace, &a.file)?;
+    for w in &trace.warnings {
+        eprintln!("warning: {w}");
+    }
     if let Some(Provenance::Video(v)) = &trace.provenance {
+        if let Some(why) = &v.sampling_reason {
+            eprintln!("sampling: {why}");
+        }
         let rows = v
             .virtual_rows
             .map(|l| format!(", {l:.1} virtual rows"))
             .unwrap_or_default();
         eprintln!(
-            "{}: {} frames {}x{} at {:.3} fps{rows}, {} Hz grid, line {:.2} Hz ({:.0}x above the noise), {} estimates (mean {:.4} Hz) in {took:.2} s",
+            "{}: {} frames {}x{} at {:.3} fps{}{rows}, {} Hz grid, {} sampling, line {:.2} Hz ({:.0}x above the noise), {} estimates (mean {:.4} Hz) in {took:.2} s",
             a.file.display(),
             v.frames,
             v.width,
             v.height,
             v.fps,
+            if v.frame_times {
+                " (variable: frame times from the container)"
+            } else {
+                ""
+            },
             trace.nominal_hz.unwrap_or(f64::NAN),
+            v.sampling,
             v.line_hz,
             v.prominence,
             trace.enf_hz.len(),

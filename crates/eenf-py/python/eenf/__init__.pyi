@@ -178,7 +178,7 @@ def video(
     readout_ms: Optional[float] = None,
     idle: Optional[Literal["auto"]] = None,
     virtual_rows: Optional[float] = None,
-    sampling: Literal["zero-pad", "naive", "global"] = "zero-pad",
+    sampling: Literal["auto", "zero-pad", "naive", "global"] = "auto",
     scene_removal: Literal["paper", "row-mean", "none"] = "paper",
     peak: Peak = "exact",
     window: float = 16.0,

@@ -97,7 +97,7 @@ impl Default for VideoSettings {
             readout_ms: None,
             idle: None,
             virtual_rows: None,
-            sampling: RowSampling::ZeroPad(IdleRows::Auto),
+            sampling: RowSampling::Auto(IdleRows::Auto),
             scene_removal: SceneRemoval::Paper,
             peak: PeakMethod::Exact,
             window: defaults::WINDOW_S,
@@ -169,10 +169,7 @@ impl VideoSettings {
             (None, Some(l)) => return Err(positive("virtual_rows", l)),
             (None, None) => IdleRows::Auto,
         };
-        let sampling = match self.sampling {
-            RowSampling::ZeroPad(_) => RowSampling::ZeroPad(idle),
-            other => other,
-        };
+        let sampling = self.sampling.with_idle_rows(idle);
         let params = EnfParams {
             nominal_hz: nominal_hz.unwrap_or(50.0),
             window_s: self.window,
