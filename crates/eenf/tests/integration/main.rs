@@ -2,6 +2,7 @@
 //! `#[cfg(test)]` modules, so that `cargo test` links the library built for the demo instead
 //! of compiling it a second time in test mode.
 
+mod clock_off_events;
 mod common;
 
 mod audio_harmonics;
