@@ -213,6 +213,24 @@ impl RowMeans {
         })
     }
 
+    /// Every row of each frame replaced by the frame's mean: what a global shutter would give.
+    pub fn frame_means_as_rows(&self) -> RowMeans {
+        let h = self.info.height.max(1);
+        let values = self
+            .values
+            .chunks_exact(h)
+            .flat_map(|f| {
+                let m = f.iter().sum::<f64>() / h as f64;
+                std::iter::repeat_n(m, h)
+            })
+            .collect();
+        RowMeans {
+            info: self.info,
+            values,
+            frame_times: self.frame_times.clone(),
+        }
+    }
+
     /// The row means with the scene taken out.
     pub fn without_scene(&self, how: SceneRemoval) -> RowMeans {
         let h = self.info.height;
@@ -433,6 +451,10 @@ fn sample(rows: &RowMeans, sampling: RowSampling, virtual_rows: Option<f64>) -> 
     }
 }
 
+/// Where frames cannot be used, `auto` samples by rows only when their line stands this many
+/// times higher than the same rows flattened to their frame means.
+const MIN_ROWS_GAIN: f64 = 1.2;
+
 /// One way of sampling one grid's flicker, measured.
 struct Candidate {
     nominal: f64,
@@ -471,6 +493,19 @@ fn candidate(
         ));
     }
     let prominence = line_prominence(&x, fs, line);
+    // `auto` asks rows for more than frames could give where one sample per frame cannot
+    // tell the line from its mirror: a global shutter's rows, all exposed at once, hold the
+    // frames' information only, and would be tracked between the two
+    if let (RowSampling::Auto(_), Err(why)) = (sampling, frame_half_band(nominal, info.fps, p)) {
+        let flat = rows.frame_means_as_rows();
+        let (y, _) = sample(&flat, sampling, virtual_rows);
+        let frames_only = line_prominence(&y, fs, line);
+        if prominence < MIN_ROWS_GAIN * frames_only {
+            return Err(format!(
+                "the rows show the {line:.0} Hz line no stronger than their frame means do ({prominence:.1}x against {frames_only:.1}x): no rolling shutter's ripple to track it by, and {why}"
+            ));
+        }
+    }
     Ok(Candidate {
         nominal,
         sampling: sampling.resolved(),
@@ -508,7 +543,8 @@ pub fn video_enf_from_rows(
         None => vec![50.0, 60.0],
     };
     let samplings = match opts.sampling {
-        RowSampling::Auto(idle) => vec![RowSampling::ZeroPad(idle), RowSampling::Global],
+        // rows tried as `Auto`: see `candidate`
+        RowSampling::Auto(idle) => vec![RowSampling::Auto(idle), RowSampling::Global],
         s => vec![s],
     };
     // every (grid, sampling) measured; the strongest line kept
