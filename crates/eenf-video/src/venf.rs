@@ -2,7 +2,7 @@
 //! exposed a row time after the one above it, so row means sample the flicker at rows·fps
 //! per second, with an idle gap between frames.
 
-use eenf_dsp::enf::{line_prominence, MIN_PROMINENCE};
+use eenf_dsp::enf::{check_near_nominal, line_prominence, MIN_PROMINENCE};
 use eenf_dsp::flicker::clock_offset_note;
 use eenf_dsp::{butter_bandpass, median_correct, sosfiltfilt, EnfParams, StftTracker};
 
@@ -211,6 +211,21 @@ impl RowMeans {
             values,
             frame_times,
         })
+    }
+
+    /// Frames per second at the median step between frames (the stated rate without times).
+    pub fn usual_fps(&self) -> f64 {
+        let Some(t) = self.frame_times.as_ref().filter(|t| t.len() > 2) else {
+            return self.info.fps;
+        };
+        let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+        let k = steps.len() / 2;
+        let median = *steps.select_nth_unstable_by(k, f64::total_cmp).1;
+        if median > 0.0 {
+            1.0 / median
+        } else {
+            self.info.fps
+        }
     }
 
     /// Every row of each frame replaced by the frame's mean: what a global shutter would give.
@@ -477,7 +492,12 @@ fn candidate(
     let info = rows.info;
     let line = 2.0 * nominal;
     let half_band = match sampling {
-        RowSampling::Global => frame_half_band(nominal, info.fps, p)?,
+        // frames timed by the container: their usual step folds the spectrum as well as
+        // their mean rate does (a 10 fps stream with one gap is still 10 fps)
+        RowSampling::Global => {
+            let usual = rows.usual_fps();
+            frame_half_band(nominal, usual, p)?.min(frame_half_band(nominal, info.fps, p)?)
+        }
         _ => p.half_band_hz,
     };
     let virtual_rows = match sampling.idle_rows() {
@@ -621,6 +641,8 @@ pub fn video_enf_from_rows(
         on_2f
     };
     let enf_hz: Vec<f64> = corrected.iter().map(|f| f / 2.0).collect();
+    // a line further off than any grid strays is not the mains (as for events and sound)
+    check_near_nominal(&enf_hz, c.nominal).map_err(|e| VideoError::Signal(e.to_string()))?;
     let warnings = clock_offset_note(2.0 * mean_of(&enf_hz), line_2f)
         .into_iter()
         .collect();

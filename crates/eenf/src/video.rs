@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
-use crate::error::Result;
-use eenf_video::{video_enf, FrameSource, VideoOptions};
+use crate::error::{Error, Result};
+use eenf_video::{video_enf, FrameSource, VideoError, VideoOptions};
 
 use crate::progress::Progress;
 use crate::trace::Trace;
@@ -12,7 +12,11 @@ use crate::trace::Trace;
 pub fn trace_video(path: &Path, opts: &VideoOptions, progress: &Progress) -> Result<Trace> {
     let mut source = FrameSource::open(path)?;
     let bar = progress.steps(0, "frames");
-    let analysis = video_enf(&mut source, opts, |n| bar.set_position(n))?;
+    // the reader's errors name the file; the signal's are named here
+    let analysis = video_enf(&mut source, opts, |n| bar.set_position(n)).map_err(|e| match e {
+        VideoError::Signal(_) => Error::from(e).context(path.display()),
+        e => e.into(),
+    })?;
     bar.finish_and_clear();
     Ok(Trace::from_video(path, &analysis, opts))
 }
