@@ -516,13 +516,13 @@ fn candidate(
     // `auto` asks rows for more than frames could give where one sample per frame cannot
     // tell the line from its mirror: a global shutter's rows, all exposed at once, hold the
     // frames' information only, and would be tracked between the two
-    if let (RowSampling::Auto(_), Err(why)) = (sampling, frame_half_band(nominal, info.fps, p)) {
+    if let (RowSampling::Auto(_), Err(_)) = (sampling, frame_half_band(nominal, info.fps, p)) {
         let flat = rows.frame_means_as_rows();
         let (y, _) = sample(&flat, sampling, virtual_rows);
         let frames_only = line_prominence(&y, fs, line);
         if prominence < MIN_ROWS_GAIN * frames_only {
             return Err(format!(
-                "the rows show the {line:.0} Hz line no stronger than their frame means do ({prominence:.1}x against {frames_only:.1}x): no rolling shutter's ripple to track it by, and {why}"
+                "the rows show the {line:.0} Hz line no stronger than their frame means do ({prominence:.1}x against {frames_only:.1}x): no rolling shutter's ripple to track it by where the frames cannot"
             ));
         }
     }

@@ -1,9 +1,11 @@
 //! V-ENF at the frame rates people record at: the simulator's cameras (global and rolling
 //! shutter) at 24–240 fps on 50 and 60 Hz grids, whose ENF is known.
 
+mod common;
+
 use eenf_dsp::agreement;
-use eenf_sim::{render_video, CameraConfig, Lamp, LampKind, MainsPhase, SimConfig, SyntheticEnf};
-use eenf_video::{frame_half_band, video_enf, FrameSource, RowSampling, VideoOptions, Y4mWriter};
+use eenf_sim::{CameraConfig, Lamp, LampKind, MainsPhase, SimConfig, SyntheticEnf};
+use eenf_video::{frame_half_band, video_enf, FrameSource, RowSampling, VideoOptions};
 
 /// A small camera at `fps`: global shutter when `readout_s` is 0, a 1/240 s exposure (which
 /// keeps most of the flicker), no anti-flicker setting.
@@ -41,13 +43,7 @@ fn render(
 ) -> (tempfile::TempPath, MainsPhase) {
     let config = incandescent(seconds, seed);
     let mains = MainsPhase::synthetic(grid, seconds + 1.0, SyntheticEnf::default(), seed);
-    let file = tempfile::Builder::new().suffix(".y4m").tempfile().unwrap();
-    let (w, h) = (camera.width as usize, camera.height as usize);
-    let mut out =
-        Y4mWriter::new(std::io::BufWriter::new(file.as_file()), w, h, camera.fps).unwrap();
-    render_video(&config, camera, &mains, |frame| out.write_frame(frame)).unwrap();
-    drop(out);
-    (file.into_temp_path(), mains)
+    (common::write_y4m(&config, camera, &mains), mains)
 }
 
 /// The CC and MAE (mHz) of `eenf video` with `sampling` against the truth, or its refusal.

@@ -1,9 +1,11 @@
 //! V-ENF against videos rendered by the simulator's frame camera, whose ENF is known.
 
+mod common;
+
 use std::io::Write;
 
 use eenf_dsp::agreement;
-use eenf_sim::{render_video, CameraConfig, MainsPhase, SimConfig, SyntheticEnf};
+use eenf_sim::{CameraConfig, MainsPhase, SimConfig, SyntheticEnf};
 use eenf_video::{
     strongest_line, video_enf, FrameSource, IdleRows, RowMeans, RowSampling, VideoError,
     VideoOptions, Y4mWriter,
@@ -17,13 +19,7 @@ fn render(camera: &CameraConfig, seconds: f64, seed: u64) -> (tempfile::TempPath
         ..SimConfig::default()
     };
     let mains = MainsPhase::synthetic(50.0, seconds + 1.0, SyntheticEnf::default(), seed);
-    let file = tempfile::Builder::new().suffix(".y4m").tempfile().unwrap();
-    let (w, h) = (camera.width as usize, camera.height as usize);
-    let mut out =
-        Y4mWriter::new(std::io::BufWriter::new(file.as_file()), w, h, camera.fps).unwrap();
-    render_video(&config, camera, &mains, |frame| out.write_frame(frame)).unwrap();
-    drop(out);
-    (file.into_temp_path(), mains)
+    (common::write_y4m(&config, camera, &mains), mains)
 }
 
 #[test]
