@@ -69,8 +69,9 @@ pub struct Sampled {
     /// What ended the stream before the file's end (damage, a wild timestamp).
     pub damage: Option<eenf_events::Damage>,
     /// The recording's flicker lines near 100 and 120 Hz, measured one way wherever a line is
-    /// reported (`info`, `extract`, `flicker-map`): in the 1 ms ON − OFF sums of every event
-    /// read, whatever the sampling traced. `None` when shorter than a second.
+    /// reported (`info`, `extract`): in the 1 ms ON − OFF sums of the events traced (the tiles
+    /// that flicker, where those are kept), whatever sampling traces them. `None` when shorter
+    /// than a second.
     pub lines: Option<[FlickerLine; 2]>,
 }
 
@@ -98,15 +99,12 @@ fn sample_reader(
     let info = reader.info().clone();
     let bar = progress.events(info.event_count, "reading events");
     let mut sampler = TemporalSampler::with_interval(sampling, dt_us);
-    // the line is measured on every event, whatever the tiles and the sampling
+    // the line is measured on the events traced, whatever the sampling
     let mut measure = Some(TemporalSampler::new(SamplingMethod::Sum, 1000));
     let mut kept = eenf_events::EventBatch::default();
     let mut events = 0u64;
     while let Some(batch) = reader.next_batch()? {
         events += batch.len() as u64;
-        if measure.as_mut().is_some_and(|m| m.push(&batch).is_err()) {
-            measure = None;
-        }
         let batch = match mask {
             Some(m) => {
                 m.filter(&batch, &mut kept);
@@ -114,6 +112,9 @@ fn sample_reader(
             }
             None => &batch,
         };
+        if measure.as_mut().is_some_and(|m| m.push(batch).is_err()) {
+            measure = None;
+        }
         sampler
             .push(batch)
             .map_err(|e| Error::from(e).context(path.display()))?;
@@ -193,6 +194,28 @@ pub fn sample_recording(
     opts: &ExtractOptions,
     progress: &Progress,
 ) -> Result<Sampled> {
+    sample_chosen(rec, opts, (opts.sampling, opts.dt_us), progress)
+}
+
+/// The flicker lines near 100 and 120 Hz of the events `opts` would trace (the camera and the
+/// tiles extraction chooses), measured as extraction measures them ([`Sampled::lines`]): what
+/// `info` reports as the line E-ENF sees. `None` when shorter than a second.
+pub fn traced_lines(
+    rec: &Recording,
+    opts: &ExtractOptions,
+    progress: &Progress,
+) -> Result<Option<[FlickerLine; 2]>> {
+    // the measure's own 1 ms sums are all that is sampled
+    Ok(sample_chosen(rec, opts, (SamplingMethod::Sum, Some(1000)), progress)?.lines)
+}
+
+/// [`sample_recording`] with the camera and tiles `opts` choose, sampled as `sampler` says.
+fn sample_chosen(
+    rec: &Recording,
+    opts: &ExtractOptions,
+    (sampling, dt_us): (SamplingMethod, Option<i64>),
+    progress: &Progress,
+) -> Result<Sampled> {
     let path = rec.name();
     let reader = rec.open(&opts.open)?;
     let cameras = reader.info().cameras.len();
@@ -237,14 +260,7 @@ pub fn sample_recording(
     } else {
         (Box::new(reader), None)
     };
-    let mut s = sample_reader(
-        reader,
-        path,
-        opts.sampling,
-        opts.dt_us,
-        mask.as_ref(),
-        progress,
-    )?;
+    let mut s = sample_reader(reader, path, sampling, dt_us, mask.as_ref(), progress)?;
     s.notes.extend(note);
     Ok(s)
 }

@@ -7,7 +7,8 @@ use crate::error::Result;
 use eenf_dsp::{flicker_line, FlickerLine, Grouping, SamplingMethod, TemporalSampler};
 use eenf_events::{OpenOptions, StreamInfo, StreamStats};
 
-use crate::extract::camera_line;
+use crate::extract::{camera_line, traced_lines, ExtractOptions};
+use crate::progress::Progress;
 use crate::recording::Recording;
 
 /// The flicker of one camera.
@@ -15,11 +16,11 @@ use crate::recording::Recording;
 pub struct CameraFlicker {
     /// The camera, in a file with several.
     pub camera: Option<u8>,
-    /// Its strongest line near 100/120 Hz in the 1 ms ON − OFF sums, the one measure `info`,
-    /// `extract` and `flicker-map` report (and real recordings are calibrated with; `None`:
-    /// shorter than a second, or no events).
+    /// Its strongest line near 100/120 Hz in the events E-ENF traces (the tiles that flicker,
+    /// where extraction keeps only those), measured as `extract` measures it: 1 ms ON − OFF
+    /// sums (`None`: shorter than a second, or no events).
     pub line: Option<FlickerLine>,
-    /// The same line (kept under this name for readers of earlier versions' JSON).
+    /// The same over the whole sensor: the measure real recordings are calibrated with.
     pub sum_line: Option<FlickerLine>,
 }
 
@@ -68,20 +69,22 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
         // two clocks: each camera on its own
         let mut out = Vec::new();
         for c in 0..info.cameras.len().min(u8::MAX as usize) as u8 {
-            let line = camera_line(&rec, open, c, SamplingMethod::Sum)?;
+            let one = OpenOptions {
+                camera: Some(c),
+                ..open.clone()
+            };
             out.push(CameraFlicker {
                 camera: Some(c),
-                line,
-                sum_line: line,
+                line: traced_line(&rec, &one)?,
+                sum_line: camera_line(&rec, open, c, SamplingMethod::Sum)?,
             });
         }
         out
     } else {
-        let line = if wild { None } else { line_of(sampler) };
         vec![CameraFlicker {
             camera: open.camera,
-            line,
-            sum_line: line,
+            line: if wild { None } else { traced_line(&rec, open)? },
+            sum_line: if wild { None } else { line_of(sampler) },
         }]
     };
     Ok(Inspection {
@@ -92,6 +95,16 @@ pub fn inspect(path: &Path, open: &OpenOptions) -> Result<Inspection> {
         flicker,
         damage,
     })
+}
+
+/// The stronger of the lines `extract` would measure in `rec` opened as `open` says.
+fn traced_line(rec: &Recording, open: &OpenOptions) -> Result<Option<FlickerLine>> {
+    let opts = ExtractOptions {
+        open: open.clone(),
+        ..ExtractOptions::default()
+    };
+    let lines = traced_lines(rec, &opts, &Progress::hidden())?;
+    Ok(lines.map(|[a, b]| if a.prominence >= b.prominence { a } else { b }))
 }
 
 impl Inspection {

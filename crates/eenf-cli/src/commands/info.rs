@@ -26,16 +26,27 @@ fn flicker_text(f: &CameraFlicker) -> String {
         .camera
         .map(|c| format!("camera {c}: "))
         .unwrap_or_default();
+    // the whole sensor's line too, where E-ENF traces only the tiles that flicker
+    let whole = f
+        .sum_line
+        .filter(|w| Some(*w) != f.line)
+        .map(|w| {
+            format!(
+                "; whole sensor: {:.3} Hz, prominence {:.1}",
+                w.hz, w.prominence
+            )
+        })
+        .unwrap_or_default();
     match f.line {
         Some(l) if l.is_mains() => format!(
-            "{who}{:.3} Hz ({} Hz grid), {:.0} dB above the noise (prominence {:.1}, in the 1 ms ON − OFF sums)",
+            "{who}{:.3} Hz ({} Hz grid), {:.0} dB above the noise (prominence {:.1} in the events E-ENF traces, as `extract` measures it{whole})",
             l.hz,
             l.grid_hz,
             l.db(),
             l.prominence
         ),
         Some(l) => format!(
-            "{who}none: the strongest line near 100/120 Hz, {:.3} Hz, stands {:.1}x above the noise",
+            "{who}none: the strongest line near 100/120 Hz, {:.3} Hz, stands {:.1}x above the noise{whole}",
             l.hz, l.prominence
         ),
         None => format!("{who}not measured (shorter than 1 s)"),
