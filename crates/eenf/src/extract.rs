@@ -100,7 +100,9 @@ fn sample_reader(
     let bar = progress.events(info.event_count, "reading events");
     let mut sampler = TemporalSampler::with_interval(sampling, dt_us);
     // the line is measured on the events traced, whatever the sampling
-    let mut measure = Some(TemporalSampler::new(SamplingMethod::Sum, 1000));
+    // (a sampler that already makes the 1 ms sums is the measure itself: no second one)
+    let is_measure = sampling == SamplingMethod::Sum && dt_us == Some(1000);
+    let mut measure = (!is_measure).then(|| TemporalSampler::new(SamplingMethod::Sum, 1000));
     let mut kept = eenf_events::EventBatch::default();
     let mut events = 0u64;
     while let Some(batch) = reader.next_batch()? {
@@ -131,9 +133,13 @@ fn sample_reader(
     let seq = sampler
         .finish()
         .map_err(|e| Error::from(e).context(path.display()))?;
-    let lines = measure
-        .and_then(|m| m.finish().ok())
-        .and_then(|m| flicker_lines(&m.signal(), m.fs()));
+    let lines = if is_measure {
+        flicker_lines(&seq.signal(), seq.fs())
+    } else {
+        measure
+            .and_then(|m| m.finish().ok())
+            .and_then(|m| flicker_lines(&m.signal(), m.fs()))
+    };
     let mut notes = info.notes.clone();
     notes.extend(mask.map(TileMask::describe));
     Ok(Sampled {
