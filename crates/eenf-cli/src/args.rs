@@ -74,7 +74,7 @@ pub struct TrackerArgs {
     #[arg(long, default_value = "exact", value_parser = one_of::<PeakMethod>(&PeakMethod::NAMES))]
     pub peak: PeakMethod,
     /// STFT window length, s. Default: 16 (the paper's); a recording shorter than that is
-    /// traced with a window that fits it, and `audio` lengthens it for weak hum.
+    /// traced with a window that fits it, and `audio` and `extract` lengthen it for a weak line.
     #[arg(long, value_parser = number_in(limits::WINDOW_S))]
     pub window: Option<f64>,
     /// STFT step, s (one estimate per step).

@@ -45,12 +45,12 @@ pub use enf::{
 };
 pub use filtfilt::sosfiltfilt;
 pub use flicker::{
-    clock_offset_note, flicker_line, flicker_lines, line_strength_at, FlickerLine,
-    MIN_FLICKER_PROMINENCE,
+    clock_offset_note, flicker_line, flicker_lines, flicker_search, line_strength_at, stronger,
+    FlickerLine, MIN_FLICKER_PROMINENCE,
 };
 pub use hum::{
-    check_holds_line, choose_window, plausibility, search_hum, HumLine, HumSearch, HumVerdict,
-    Plausibility,
+    check_holds_line, choose_window, plausibility, search_flicker, search_hum, HumLine, HumSearch,
+    HumVerdict, Plausibility,
 };
 pub use metrics::{agreement, robust_spread, Agreement};
 pub use postprocess::{

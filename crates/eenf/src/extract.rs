@@ -5,9 +5,9 @@ use std::path::Path;
 
 use crate::error::{error, fail, Error, Result};
 use eenf_dsp::{
-    check_line, clock_offset_note, decimate, decimation_for, detect_nominal, enf_from_flicker,
-    flicker_line, flicker_lines, EnfParams, FlickerLine, Grouping, PolaritySequence,
-    SamplingMethod, TemporalSampler, MIN_FLICKER_PROMINENCE,
+    check_line, choose_window, clock_offset_note, decimate, decimation_for, detect_nominal,
+    enf_from_flicker, flicker_line, flicker_lines, flicker_search, stronger, EnfParams,
+    FlickerLine, Grouping, HumSearch, PolaritySequence, SamplingMethod, TemporalSampler,
 };
 use eenf_events::{EventReader, OpenOptions, StreamInfo};
 
@@ -35,6 +35,9 @@ pub struct ExtractOptions {
     /// Trace only the tiles of pixels that flicker (see [`crate::flicker_map`]) when events
     /// are stamped one by one; scan-grouped streams (DVXplorer) are always read whole.
     pub flicker_tiles: bool,
+    /// True when `params.window_s` was asked for: it is kept. Otherwise a weak line that the
+    /// recording is long enough for gets a longer window ([`eenf_dsp::choose_window`]).
+    pub window_given: bool,
 }
 
 impl Default for ExtractOptions {
@@ -46,6 +49,7 @@ impl Default for ExtractOptions {
             params: EnfParams::default(),
             open: OpenOptions::default(),
             flicker_tiles: true,
+            window_given: false,
         }
     }
 }
@@ -69,10 +73,13 @@ pub struct Sampled {
     /// What ended the stream before the file's end (damage, a wild timestamp).
     pub damage: Option<eenf_events::Damage>,
     /// The recording's flicker lines near 100 and 120 Hz, measured one way wherever a line is
-    /// reported (`info`, `extract`): in the 1 ms ON − OFF sums of the events traced (the tiles
-    /// that flicker, where those are kept), whatever sampling traces them. `None` when shorter
-    /// than a second.
+    /// reported (`info`, `extract`, `flicker-map`): in the 1 ms ON − OFF sums of the events
+    /// traced (the tiles that flicker, where those are kept), whatever sampling traces them.
+    /// `None` when shorter than a second.
     pub lines: Option<[FlickerLine; 2]>,
+    /// The search over those sums' lines at 2k·f0 that decides the grid
+    /// ([`eenf_dsp::flicker_search`]).
+    pub search: Option<HumSearch>,
 }
 
 /// Reads `rec` (as `open` says) into a flicker signal sampled with `sampling` every `dt_us`.
@@ -133,12 +140,16 @@ fn sample_reader(
     let seq = sampler
         .finish()
         .map_err(|e| Error::from(e).context(path.display()))?;
-    let lines = if is_measure {
-        flicker_lines(&seq.signal(), seq.fs())
+    let measured = if is_measure {
+        flicker_search(&seq.signal(), seq.fs())
     } else {
         measure
             .and_then(|m| m.finish().ok())
-            .and_then(|m| flicker_lines(&m.signal(), m.fs()))
+            .and_then(|m| flicker_search(&m.signal(), m.fs()))
+    };
+    let (lines, search) = match measured {
+        Some((lines, search)) => (Some(lines), search),
+        None => (None, None),
     };
     let mut notes = info.notes.clone();
     notes.extend(mask.map(TileMask::describe));
@@ -150,6 +161,7 @@ fn sample_reader(
         seq,
         damage,
         lines,
+        search,
     })
 }
 
@@ -229,20 +241,20 @@ fn sample_chosen(
     let (reader, open, note) = if cameras < 2 || opts.open.camera.is_some() {
         (Some(reader), opts.open.clone(), None)
     } else {
-        let mut best: Option<(u8, f64)> = None;
+        let mut best: Option<(u8, (bool, f64))> = None;
         let mut heard = Vec::new();
         for c in 0..cameras.min(u8::MAX as usize) as u8 {
             let line = camera_line(rec, &opts.open, c, SamplingMethod::Sum)?;
-            let prominence = line.map_or(0.0, |l| l.prominence);
+            let rank = line.map_or((false, f64::NEG_INFINITY), |l| eenf_dsp::flicker::rank(&l));
             heard.push(match line {
-                Some(l) => format!("camera {c}: {:.3} Hz, {:.1}x", l.hz, l.prominence),
+                Some(l) => format!("camera {c}: {:.3} Hz, {}", l.hz, l.strength()),
                 None => format!("camera {c}: no line"),
             });
-            if best.is_none_or(|b| prominence > b.1) {
-                best = Some((c, prominence));
+            if best.is_none_or(|b| rank > b.1) {
+                best = Some((c, rank));
             }
         }
-        let (camera, _) = best.unwrap_or((0, 0.0));
+        let camera = best.map_or(0, |b| b.0);
         let note = format!(
             "{cameras} cameras: camera {camera} traced, its flicker stands highest ({}); {} picks another",
             heard.join("; "),
@@ -260,13 +272,28 @@ fn sample_chosen(
         Some(r) => r,
         None => rec.open(&open)?,
     })?;
-    let (reader, mask): (Box<dyn EventReader>, _) = if wants_tiles(opts, &reader) {
+    let (reader, mask, whole): (Box<dyn EventReader>, _, _) = if wants_tiles(opts, &reader) {
         let map = flicker_map_of(Box::new(reader), path, None, progress)?;
-        (rec.open(&open)?, TileMask::from_map(&map))
+        (rec.open(&open)?, TileMask::from_map(&map), map.whole)
     } else {
-        (Box::new(reader), None)
+        (Box::new(reader), None, None)
     };
     let mut s = sample_reader(reader, path, sampling, dt_us, mask.as_ref(), progress)?;
+    // tiles are kept to raise the line; where they lose a line the whole sensor shows, every
+    // pixel is traced instead
+    let stands = |l: &Option<[FlickerLine; 2]>| l.is_some_and(|l| l.iter().any(|l| l.stands));
+    if let (Some(_), Some(w)) = (&mask, whole.filter(|w| w.stands)) {
+        if !stands(&s.lines) {
+            let tiles = s.lines.map(stronger);
+            s = sample_reader(rec.open(&open)?, path, sampling, dt_us, None, progress)?;
+            s.notes.push(format!(
+                "the flicker tiles' line does not stand ({}): every pixel traced, where it does ({:.3} Hz, {})",
+                tiles.map_or("too short to measure".into(), |l| format!("{:.3} Hz, {}", l.hz, l.strength())),
+                w.hz,
+                w.strength()
+            ));
+        }
+    }
     s.notes.extend(note);
     Ok(s)
 }
@@ -318,9 +345,10 @@ pub fn extract(rec: &Recording, opts: &ExtractOptions, progress: &Progress) -> R
     })
 }
 
-/// The grid of a flicker signal: decided from the recording's strongest line near 100/120 Hz
-/// (`lines`, see [`Sampled::lines`]), or checked against `nominal`. Also returns the line, and a note when the line sits off twice the grid
-/// by more than a grid wanders (a camera clock that runs off).
+/// The grid of a flicker signal: that of the line that stands among the recording's strongest
+/// near 100 and 120 Hz (`lines`, see [`Sampled::lines`]), or checked against `nominal`. Also
+/// returns the line, and a note when the line sits off twice the grid by more than a grid
+/// wanders (a camera clock that runs off).
 fn decide_grid(
     x: &[f64],
     fs: f64,
@@ -330,15 +358,16 @@ fn decide_grid(
 ) -> std::result::Result<(f64, Option<FlickerLine>, Option<String>), eenf_dsp::DspError> {
     let line = match (nominal, lines) {
         (_, None) => None,
-        (Nominal::Auto, Some([a, b])) => Some(if a.prominence >= b.prominence { a } else { b }),
+        (Nominal::Auto, Some(l)) => Some(stronger(l)),
         (Nominal::Grid(g), Some(l)) => Some(line_at(l, g)),
     };
     let f0 = match (nominal, line) {
-        (Nominal::Auto, Some(l)) if l.is_mains() => l.grid_hz,
+        (Nominal::Auto, Some(l)) if l.stands => l.grid_hz,
         (Nominal::Auto, Some(l)) => {
             return Err(eenf_dsp::DspError::NoTone(format!(
-                "no mains flicker: the strongest line near 100 or 120 Hz, at {:.3} Hz, stands {:.1}x above the noise ({MIN_FLICKER_PROMINENCE}x needed)",
-                l.hz, l.prominence
+                "no mains flicker: the strongest line near 100 or 120 Hz, at {:.3} Hz, does not stand: {}",
+                l.hz,
+                l.strength()
             )))
         }
         // too short or sampled too slowly for the whole-recording line: the older local test
@@ -346,7 +375,7 @@ fn decide_grid(
         (Nominal::Grid(g), l) => {
             let f = g.hz();
             // the flicker line may be weak at 2f0 yet strong at a higher harmonic
-            let ok = l.is_some_and(|l| l.is_mains())
+            let ok = l.is_some_and(|l| l.stands)
                 || (1..=harmonics.max(1)).any(|m| check_line(x, fs, f, 2.0 * m as f64).is_ok());
             if !ok {
                 check_line(x, fs, f, 2.0)?;
@@ -355,7 +384,7 @@ fn decide_grid(
         }
     };
     let note = line
-        .filter(|l| l.is_mains())
+        .filter(|l| l.stands)
         .and_then(|l| clock_offset_note(l.hz, 2.0 * l.grid_hz));
     Ok((f0, line, note))
 }
@@ -413,6 +442,19 @@ pub fn extract_sampled(
     let (f0, line, note) =
         decide_grid(&x, fs, s.lines, opts.nominal, params.harmonics).map_err(err)?;
     params.nominal_hz = f0;
+    // a line that stands over the whole recording but weakly: a longer window, where the
+    // recording holds it, rather than a window that follows the noise
+    if let (false, Some(search)) = (
+        opts.window_given || duration < opts.params.window_s,
+        &s.search,
+    ) {
+        if let Some(db) = search.of_grid(f0).map(|l| l.db).next() {
+            let (window, why) =
+                choose_window(duration, params.window_s, db, search.segment_s).map_err(err)?;
+            params.window_s = window;
+            notes.extend(why);
+        }
+    }
     // a clock that runs off is a warning as well as a note: every estimate is off by as much
     let warnings: Vec<String> = note.iter().cloned().collect();
     notes.extend(note);

@@ -128,8 +128,7 @@ pub fn flicker_map_of(
     let used = last_bin + 1;
     let fs = 1e6 / BIN_US as f64;
     let whole_x: Vec<f64> = whole[..used].iter().map(|&v| v as f64).collect();
-    let whole_line =
-        flicker_lines(&whole_x, fs).map(|[a, b]| if a.prominence >= b.prominence { a } else { b });
+    let whole_line = flicker_lines(&whole_x, fs).map(eenf_dsp::stronger);
     let strength: Vec<Option<f64>> = (0..cols * rows)
         .into_par_iter()
         .map(|k| {

@@ -104,7 +104,7 @@ fn traced_line(rec: &Recording, open: &OpenOptions) -> Result<Option<FlickerLine
         ..ExtractOptions::default()
     };
     let lines = traced_lines(rec, &opts, &Progress::hidden())?;
-    Ok(lines.map(|[a, b]| if a.prominence >= b.prominence { a } else { b }))
+    Ok(lines.map(eenf_dsp::stronger))
 }
 
 impl Inspection {

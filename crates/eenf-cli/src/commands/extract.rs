@@ -40,7 +40,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             x.duration_s,
             x.params.nominal_hz,
             x.flicker
-                .map(|l| format!(" (flicker {:.3} Hz, {:.0} dB above the noise)", l.hz, l.db()))
+                .map(|l| format!(" (flicker {:.3} Hz, {})", l.hz, l.strength()))
                 .unwrap_or_default(),
             x.sampling,
             trace.enf_hz.len(),

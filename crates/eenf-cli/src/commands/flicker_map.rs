@@ -35,18 +35,24 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         eprintln!("warning: {d}");
     }
     let whole = match map.whole {
-        Some(l) => format!("{:.3} Hz, {:.0} dB over the whole sensor", l.hz, l.db()),
+        Some(l) => format!("{:.3} Hz over the whole sensor, {}", l.hz, l.strength()),
         None => "no line measured".to_string(),
     };
     let share = 100.0 * map.flickering_share();
     let title = match map.whole {
         Some(l) => format!(
-            "{}: flicker at {:.3} Hz, {:.0} dB over the noise; it stands out in {share:.0} % of the tiles",
+            "{}: flicker at {:.3} Hz, {}; it stands out in {share:.0} % of the tiles",
             eenf_figures::title_name(&a.file),
             l.hz,
-            l.db()
+            l.floor_db
+                .map_or(format!("prominence {:.1}", l.prominence), |db| format!(
+                    "{db:.0} dB over its floor"
+                ))
         ),
-        None => format!("{}: no flicker line measured", eenf_figures::title_name(&a.file)),
+        None => format!(
+            "{}: no flicker line measured",
+            eenf_figures::title_name(&a.file)
+        ),
     };
     let picture = match (&a.output, a.json) {
         (Some(p), _) => Some(p.clone()),

@@ -20,7 +20,8 @@ pub struct Args {
     pub read: InputArgs,
 }
 
-/// `flicker 119.99 Hz (60 Hz grid), 38 dB above the noise`, or why there is none.
+/// `119.990 Hz (60 Hz grid), in the events E-ENF traces, as `extract` measures it: 38.2 dB
+/// over its local floor and prominence …`, or why there is none.
 fn flicker_text(f: &CameraFlicker) -> String {
     let who = f
         .camera
@@ -30,24 +31,19 @@ fn flicker_text(f: &CameraFlicker) -> String {
     let whole = f
         .sum_line
         .filter(|w| Some(*w) != f.line)
-        .map(|w| {
-            format!(
-                "; whole sensor: {:.3} Hz, prominence {:.1}",
-                w.hz, w.prominence
-            )
-        })
+        .map(|w| format!("; whole sensor: {:.3} Hz, {}", w.hz, w.strength()))
         .unwrap_or_default();
     match f.line {
         Some(l) if l.is_mains() => format!(
-            "{who}{:.3} Hz ({} Hz grid), {:.0} dB above the noise (prominence {:.1} in the events E-ENF traces, as `extract` measures it{whole})",
+            "{who}{:.3} Hz ({} Hz grid), in the events E-ENF traces, as `extract` measures it: {}{whole}",
             l.hz,
             l.grid_hz,
-            l.db(),
-            l.prominence
+            l.strength()
         ),
         Some(l) => format!(
-            "{who}none: the strongest line near 100/120 Hz, {:.3} Hz, stands {:.1}x above the noise{whole}",
-            l.hz, l.prominence
+            "{who}none: the strongest line near 100/120 Hz, {:.3} Hz, does not stand: {}{whole}",
+            l.hz,
+            l.strength()
         ),
         None => format!("{who}not measured (shorter than 1 s)"),
     }

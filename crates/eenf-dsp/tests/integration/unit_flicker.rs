@@ -5,8 +5,8 @@ use eenf_dsp::flicker::*;
 
 use crate::test_noise as noise;
 
-/// A tone in noise: the line is found to a few mHz and its prominence grows with its
-/// amplitude; noise alone stays below the threshold.
+/// A tone in noise: the line is found to a few mHz, stands, and its prominence grows with its
+/// amplitude; noise alone does not stand.
 #[test]
 fn finds_a_line_in_noise_and_none_in_noise_alone() {
     let fs = 1000.0;
@@ -14,7 +14,11 @@ fn finds_a_line_in_noise_and_none_in_noise_alone() {
     let mut draw = noise(0x1234_5678_9abc_def0);
     let noise: Vec<f64> = (0..n).map(|_| draw()).collect();
     let alone = flicker_line(&noise, fs).unwrap();
-    assert!(alone.prominence < MIN_FLICKER_PROMINENCE, "{alone:?}");
+    assert!(!alone.stands, "{alone:?}");
+    assert!(
+        alone.floor_db.unwrap() < alone.threshold_db.unwrap(),
+        "{alone:?}"
+    );
     let tone = |a: f64, f: f64| -> Vec<f64> {
         noise
             .iter()

@@ -79,7 +79,8 @@ pub struct TrackerSettings {
     pub nominal: Nominal,
     /// `peak`: how each window's peak is refined.
     pub peak: PeakMethod,
-    /// `window`: STFT window, s (default: the paper's 16, or one that fits).
+    /// `window`: STFT window, s (default: the paper's 16, one that fits a shorter recording,
+    /// or twice that for a weak line).
     pub window: Option<f64>,
     /// `step`: STFT step, s.
     pub step: f64,
@@ -256,6 +257,7 @@ impl ExtractSettings {
             params,
             open: self.input.open_options(),
             flicker_tiles: !self.all_pixels,
+            window_given: self.tracker.window.is_some(),
         })
     }
 }
