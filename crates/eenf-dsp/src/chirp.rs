@@ -41,12 +41,36 @@ pub fn follow_chirps(
     reach_hz: f64,
     passes: usize,
 ) -> Vec<f64> {
-    let q = ((fs / BASEBAND_HZ).floor() as usize).max(1);
-    let base = baseband(y, fs, center_hz, q);
+    let q = baseband_block(fs);
+    let base = baseband(y, 0, fs, center_hz, q);
+    follow_in_baseband(
+        &base, fs, center_hz, line_hz, window_s, step_s, reach_hz, passes,
+    )
+}
+
+/// The samples (at `fs`) averaged into one baseband value of [`follow_chirps`].
+pub fn baseband_block(fs: f64) -> usize {
+    ((fs / BASEBAND_HZ).floor() as usize).max(1)
+}
+
+/// [`follow_chirps`] from the line's baseband (made whole, or a block at a time by
+/// [`baseband`]).
+#[allow(clippy::too_many_arguments)]
+pub fn follow_in_baseband(
+    base: &[Complex64],
+    fs: f64,
+    center_hz: f64,
+    line_hz: &[f64],
+    window_s: f64,
+    step_s: f64,
+    reach_hz: f64,
+    passes: usize,
+) -> Vec<f64> {
+    let q = baseband_block(fs);
     let mut estimates = line_hz.to_vec();
     for _ in 0..passes {
         estimates = follow_once(
-            &base, q, fs, center_hz, &estimates, window_s, step_s, reach_hz,
+            base, q, fs, center_hz, &estimates, window_s, step_s, reach_hz,
         );
     }
     estimates
@@ -104,13 +128,15 @@ fn follow_once(
         .collect()
 }
 
-/// `y` shifted down by `center_hz` and averaged over blocks of `q` samples.
-fn baseband(y: &[f64], fs: f64, center_hz: f64, q: usize) -> Vec<Complex64> {
+/// `y` shifted down by `center_hz` and averaged over blocks of `q` samples; `y`'s first
+/// sample is the signal's sample `start` (a multiple of `q`), so that a long signal's
+/// baseband can be made a part at a time.
+pub fn baseband(y: &[f64], start: usize, fs: f64, center_hz: f64, q: usize) -> Vec<Complex64> {
     let w = -2.0 * PI * center_hz / fs;
     y.par_chunks(q)
         .enumerate()
         .map(|(b, chunk)| {
-            let start = b * q;
+            let start = start + b * q;
             // the phasor is computed afresh per block, so rounding does not accumulate
             let mut rot = Complex64::from_polar(1.0, w * start as f64);
             let step = Complex64::from_polar(1.0, w);

@@ -1,10 +1,11 @@
 //! The E-ENF pipeline on a sampled flicker signal, and the reference tracker for mains signals.
 
 use rayon::prelude::*;
+use realfft::num_complex::Complex64;
 use realfft::RealFftPlanner;
 
 use crate::butter::butter_bandpass;
-use crate::chirp::follow_chirps;
+use crate::chirp::{baseband, baseband_block, follow_in_baseband};
 use crate::filtfilt::sosfiltfilt;
 use crate::postprocess::{median_correct, select_audible_harmonics, HarmonicSelection};
 use crate::sampling::{PolaritySequence, SamplingError};
@@ -60,7 +61,8 @@ impl Default for EnfParams {
 }
 
 impl EnfParams {
-    fn tracker(&self, fs: f64) -> StftTracker {
+    /// The STFT tracker these parameters describe, at `fs`.
+    pub fn tracker(&self, fs: f64) -> StftTracker {
         StftTracker {
             fs,
             window_s: self.window_s,
@@ -100,6 +102,9 @@ pub enum DspError {
     /// The sampler refused the events.
     #[error(transparent)]
     Sampling(#[from] SamplingError),
+    /// A signal kept on disk could not be read back.
+    #[error("the signal could not be read back from its temporary file: {0}")]
+    Read(String),
 }
 
 /// The ENF traced on one flicker harmonic.
@@ -169,7 +174,7 @@ pub fn enf_from_harmonics(
 }
 
 /// [`enf_from_harmonics`] for hum in sound (`multiple` 1), each band's estimates followed
-/// through the window's sweep ([`follow_chirps`]) when the peak is the exact one: weak hum at
+/// through the window's sweep ([`crate::chirp::follow_chirps`]) when the peak is the exact one: weak hum at
 /// k·f0 sweeps k times as fast as the ENF, and its line then spreads over several bins. Only
 /// bands whose line a fast swing moves by two bins or more within a window are followed (4 f0
 /// in the 32 s windows weak hum gets, say), and only in recordings of
@@ -216,7 +221,36 @@ fn harmonics_enf(
     harmonics: &[usize],
     follow: bool,
 ) -> Result<EnfEstimates, DspError> {
-    let duration_s = x.len() as f64 / fs;
+    let bands = bands_of(x.len(), fs, p, multiple, harmonics)?;
+    let tracker = p.tracker(fs);
+    let tracks: Vec<BandTrack> = bands
+        .par_iter()
+        .map(|&m| {
+            let b = BandTrack::new(m, p, multiple, follow);
+            let y = sosfiltfilt(&b.filter(fs, p), x);
+            BandTrack {
+                tracked: tracker.track_with_snr(&y, b.band),
+                base: b
+                    .follows
+                    .then(|| baseband(&y, 0, fs, b.center_hz, baseband_block(fs))),
+                ..b
+            }
+        })
+        .collect();
+    finish_bands(tracks, fs, p, multiple)
+}
+
+/// The bands a recording of `len` samples at `fs` is tracked in: the `harmonics` whose band
+/// fits below the Nyquist frequency, in order. Errors when it is shorter than a window or
+/// none fits.
+pub fn bands_of(
+    len: usize,
+    fs: f64,
+    p: &EnfParams,
+    multiple: f64,
+    harmonics: &[usize],
+) -> Result<Vec<usize>, DspError> {
+    let duration_s = len as f64 / fs;
     if duration_s < p.window_s {
         return Err(DspError::TooShort {
             duration_s,
@@ -237,37 +271,92 @@ fn harmonics_enf(
             nyquist_hz: nyquist,
         });
     }
-    let tracker = p.tracker(fs);
-    let harmonics: Vec<HarmonicEstimates> = bands
-        .par_iter()
-        .map(|&m| {
-            let center = multiple * m as f64 * p.nominal_hz;
-            let band = (center - p.half_band_hz, center + p.half_band_hz);
-            let sos = butter_bandpass(p.filter_order, band.0, band.1, fs);
-            let y = sosfiltfilt(&sos, x);
-            let tracked = tracker.track_with_snr(&y, band);
+    Ok(bands)
+}
+
+/// One band's tracking before the estimates are corrected and chosen: the tracker's peak and
+/// line strength per window, and (when the band is followed through its sweep) the line's
+/// baseband.
+#[derive(Debug, Clone)]
+pub struct BandTrack {
+    /// The harmonic m (the band sits at m·multiple·f0).
+    pub harmonic: usize,
+    /// The band's centre, Hz.
+    pub center_hz: f64,
+    /// The band, Hz.
+    pub band: (f64, f64),
+    /// Whether the band is followed through its sweep ([`crate::chirp::follow_chirps`]).
+    pub follows: bool,
+    /// The tracker's (frequency, line strength in dB) per window.
+    pub tracked: Vec<(f64, f64)>,
+    /// The band-passed line's baseband ([`baseband`]), when followed.
+    pub base: Option<Vec<Complex64>>,
+}
+
+impl BandTrack {
+    /// Band `m` before tracking; `follow` when following is asked for (exact peaks over
+    /// enough windows).
+    pub fn new(m: usize, p: &EnfParams, multiple: f64, follow: bool) -> Self {
+        let center = multiple * m as f64 * p.nominal_hz;
+        // bins a fast swing of the grid moves this band's line within one window
+        let sweep_bins = multiple * m as f64 * FAST_SWING_HZ_PER_S * p.window_s.powi(2);
+        BandTrack {
+            harmonic: m,
+            center_hz: center,
+            band: (center - p.half_band_hz, center + p.half_band_hz),
+            follows: follow && sweep_bins >= FOLLOW_MIN_SWEEP_BINS,
+            tracked: Vec::new(),
+            base: None,
+        }
+    }
+
+    /// The band-pass the band's line is taken through.
+    pub fn filter(&self, fs: f64, p: &EnfParams) -> Vec<crate::butter::Section> {
+        butter_bandpass(p.filter_order, self.band.0, self.band.1, fs)
+    }
+}
+
+/// The estimates from every band's tracking: outliers corrected, followed bands dechirped,
+/// the band chosen per segment, and the trace checked against nominal.
+pub fn finish_bands(
+    tracks: Vec<BandTrack>,
+    fs: f64,
+    p: &EnfParams,
+    multiple: f64,
+) -> Result<EnfEstimates, DspError> {
+    let harmonics: Vec<HarmonicEstimates> = tracks
+        .into_par_iter()
+        .map(|b| {
+            let m = b.harmonic;
             // correct outliers on the first line's scale, report on the f_e scale
-            let on_first: Vec<f64> = tracked.iter().map(|(f, _)| f / m as f64).collect();
+            let on_first: Vec<f64> = b.tracked.iter().map(|(f, _)| f / m as f64).collect();
             let mut corrected = if p.median_len > 1 {
                 median_correct(&on_first, p.median_len, p.median_threshold_hz)
             } else {
                 on_first
             };
-            // bins a fast swing of the grid moves this band's line within one window
-            let sweep_bins = multiple * m as f64 * FAST_SWING_HZ_PER_S * p.window_s.powi(2);
-            if follow && sweep_bins >= FOLLOW_MIN_SWEEP_BINS {
+            if let Some(base) = b.base.as_deref().filter(|_| b.follows) {
                 // twice: the first pass's steps bend the sweep rates the second one uses
                 let m = m as f64;
                 let reach = FOLLOW_REACH_HZ * m;
                 let line: Vec<f64> = corrected.iter().map(|f| f * m).collect();
-                let followed = follow_chirps(&y, fs, center, &line, p.window_s, p.step_s, reach, 2);
+                let followed = follow_in_baseband(
+                    base,
+                    fs,
+                    b.center_hz,
+                    &line,
+                    p.window_s,
+                    p.step_s,
+                    reach,
+                    2,
+                );
                 corrected = followed.iter().map(|f| f / m).collect();
             }
             HarmonicEstimates {
                 harmonic: m,
-                center_hz: center,
+                center_hz: b.center_hz,
                 enf_hz: corrected.iter().map(|f| f / multiple).collect(),
-                snr_db: tracked.iter().map(|(_, s)| *s).collect(),
+                snr_db: b.tracked.iter().map(|(_, s)| *s).collect(),
             }
         })
         .collect();
@@ -364,7 +453,24 @@ pub fn reference_enf_with_snr(
     fs: f64,
     p: &EnfParams,
 ) -> Result<(Vec<f64>, Vec<f64>), DspError> {
-    let duration_s = x.len() as f64 / fs;
+    check_reference(x.len(), fs, p)?;
+    let band = (p.nominal_hz - p.half_band_hz, p.nominal_hz + p.half_band_hz);
+    let (enf, snr_db): (Vec<f64>, Vec<f64>) =
+        p.tracker(fs).track_with_snr(x, band).into_iter().unzip();
+    if enf.iter().all(|v| !v.is_finite()) {
+        return Err(DspError::NoTone(format!(
+            "no line inside {:.2}-{:.2} Hz (each window's peak sat at the band's edge)",
+            band.0, band.1
+        )));
+    }
+    check_near_nominal(&enf, p.nominal_hz)?;
+    Ok((enf, snr_db))
+}
+
+/// What [`reference_enf_with_snr`] needs of a signal of `len` samples at `fs`: a window's
+/// length, and f0's band below the Nyquist frequency.
+pub(crate) fn check_reference(len: usize, fs: f64, p: &EnfParams) -> Result<(), DspError> {
+    let duration_s = len as f64 / fs;
     if duration_s < p.window_s {
         return Err(DspError::TooShort {
             duration_s,
@@ -377,17 +483,7 @@ pub fn reference_enf_with_snr(
             nyquist_hz: fs / 2.0,
         });
     }
-    let band = (p.nominal_hz - p.half_band_hz, p.nominal_hz + p.half_band_hz);
-    let (enf, snr_db): (Vec<f64>, Vec<f64>) =
-        p.tracker(fs).track_with_snr(x, band).into_iter().unzip();
-    if enf.iter().all(|v| !v.is_finite()) {
-        return Err(DspError::NoTone(format!(
-            "no line inside {:.2}-{:.2} Hz (each window's peak sat at the band's edge)",
-            band.0, band.1
-        )));
-    }
-    check_near_nominal(&enf, p.nominal_hz)?;
-    Ok((enf, snr_db))
+    Ok(())
 }
 
 /// How far from its nominal a grid's frequency may stay for the length of a recording: grids

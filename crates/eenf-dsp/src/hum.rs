@@ -15,6 +15,7 @@ use eenf_core::spelling::option;
 use rayon::prelude::*;
 use realfft::RealFftPlanner;
 
+use crate::blocks::BlockSource;
 use crate::enf::{DspError, MAX_NOMINAL_OFFSET_HZ};
 
 /// The highest harmonic looked for: a recorder's hum often stands strongest at 2–4 f0, and
@@ -102,6 +103,19 @@ pub fn search_hum(
     grids: &[f64],
     max_harmonic: usize,
 ) -> Option<HumSearch> {
+    search_lines(&x, fs, multiple, grids, max_harmonic, 0.0)
+        .ok()
+        .flatten()
+}
+
+/// [`search_hum`] over a signal read a block at a time (only the Welch segments are read).
+pub fn search_hum_in(
+    x: &dyn BlockSource,
+    fs: f64,
+    multiple: f64,
+    grids: &[f64],
+    max_harmonic: usize,
+) -> Result<Option<HumSearch>, DspError> {
     search_lines(x, fs, multiple, grids, max_harmonic, 0.0)
 }
 
@@ -110,7 +124,9 @@ pub fn search_hum(
 /// [`FLICKER_CLOCK_SHARE`]: the camera's clock, which times every event or frame, may run
 /// off, and moves every line by the same share.
 pub fn search_flicker(x: &[f64], fs: f64, grids: &[f64], max_harmonic: usize) -> Option<HumSearch> {
-    search_lines(x, fs, 2.0, grids, max_harmonic, FLICKER_CLOCK_SHARE)
+    search_lines(&x, fs, 2.0, grids, max_harmonic, FLICKER_CLOCK_SHARE)
+        .ok()
+        .flatten()
 }
 
 /// How far off a camera's clock may run, as a share, for its flicker lines still to be found:
@@ -121,16 +137,16 @@ pub const FLICKER_CLOCK_SHARE: f64 = 0.006;
 /// [`search_hum`] with each line looked for `clock_share` of its place further (a clock that
 /// runs off).
 fn search_lines(
-    x: &[f64],
+    x: &dyn BlockSource,
     fs: f64,
     multiple: f64,
     grids: &[f64],
     max_harmonic: usize,
     clock_share: f64,
-) -> Option<HumSearch> {
+) -> Result<Option<HumSearch>, DspError> {
     let duration = x.len() as f64 / fs;
     if fs.is_nan() || fs <= 0.0 || duration < 1.0 {
-        return None;
+        return Ok(None);
     }
     // at least three half-overlapping segments, each at most 16 s
     let segment_s = (duration / 2.0).min(MAX_SEGMENT_S);
@@ -147,7 +163,13 @@ fn search_lines(
             }
         })
         .collect();
-    let power = welch(x, seg, &starts)?;
+    let segments = starts
+        .iter()
+        .map(|&s| x.read(s..s + seg))
+        .collect::<Result<Vec<_>, _>>()?;
+    let Some(power) = welch(&segments) else {
+        return Ok(None);
+    };
     let nfft = (power.len() - 1) * 2;
     let df = fs / nfft as f64;
     // lines, and their bins searched, before the threshold is known
@@ -197,19 +219,19 @@ fn search_lines(
         }
     }
     if found.is_empty() {
-        return None;
+        return Ok(None);
     }
     let threshold_db = noise_threshold_db(effective_segments(starts.len(), hop, seg), tests);
     for l in &mut found {
         l.threshold_db = threshold_db.max(MIN_LINE_DB);
     }
-    Some(HumSearch {
+    Ok(Some(HumSearch {
         segment_s: seg as f64 / fs,
         segments: starts.len(),
         noise_db: threshold_db,
         multiple,
         lines: found,
-    })
+    }))
 }
 
 impl HumSearch {
@@ -347,13 +369,14 @@ const CONFIRM_MARGIN_DB: f64 = 3.0;
 
 /// The average power spectrum of Hann-windowed segments of `x` of `seg` samples starting at
 /// `starts` (zero-padded to a power of two), computed on every core.
-fn welch(x: &[f64], seg: usize, starts: &[usize]) -> Option<Vec<f64>> {
+fn welch(segments: &[Vec<f64>]) -> Option<Vec<f64>> {
+    let seg = segments.first()?.len();
     let nfft = seg.next_power_of_two();
     let fft = RealFftPlanner::<f64>::new().plan_fft_forward(nfft);
     let window: Vec<f64> = (0..seg)
         .map(|i| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / seg as f64).cos())
         .collect();
-    let sum = starts
+    let sum = segments
         .par_iter()
         .fold(
             || {
@@ -363,8 +386,7 @@ fn welch(x: &[f64], seg: usize, starts: &[usize]) -> Option<Vec<f64>> {
                     fft.make_output_vec(),
                 )
             },
-            |(mut acc, mut input, mut spec), &s| {
-                let part = &x[s..s + seg];
+            |(mut acc, mut input, mut spec), part| {
                 let mean = part.iter().sum::<f64>() / seg as f64;
                 for ((d, v), w) in input.iter_mut().zip(part).zip(&window) {
                     *d = (v - mean) * w;

@@ -19,6 +19,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod blocks;
 pub mod butter;
 pub mod chirp;
 pub mod decimate;

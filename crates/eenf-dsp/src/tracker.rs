@@ -80,7 +80,8 @@ impl StftTracker {
         (self.window_s * self.fs).round().max(1.0) as usize
     }
 
-    fn step_len(&self) -> usize {
+    /// Samples between windows.
+    pub fn step_len(&self) -> usize {
         (self.step_s * self.fs).round().max(1.0) as usize
     }
 
@@ -107,16 +108,50 @@ impl StftTracker {
     /// [`StftTracker::track`], with each window's line strength: the peak's power over the
     /// median power of the band, in dB (noise alone gives about 8 dB; NaN without energy).
     pub fn track_with_snr(&self, x: &[f64], band: (f64, f64)) -> Vec<(f64, f64)> {
+        self.track_frames(x, 0, x.len(), 0..self.frame_count(x.len()), band)
+    }
+
+    /// The samples (of a signal of `len`) that frames `frames` read: what a block must hold
+    /// for [`StftTracker::track_frames`].
+    pub fn frames_span(
+        &self,
+        frames: std::ops::Range<usize>,
+        len: usize,
+    ) -> std::ops::Range<usize> {
+        let (n, step) = (self.window_len(), self.step_len());
+        let lo = (frames.start * step).saturating_sub(n / 2).min(len);
+        let hi = (frames.end.saturating_sub(1) * step + n)
+            .saturating_sub(n / 2)
+            .min(len);
+        lo..hi.max(lo)
+    }
+
+    /// [`StftTracker::track_with_snr`]'s frames `frames` of a signal of `len` samples, of
+    /// which `block` holds those from `block_start` on (at least [`StftTracker::frames_span`]):
+    /// a long signal tracked a block at a time gives what it gives whole.
+    pub fn track_frames(
+        &self,
+        block: &[f64],
+        block_start: usize,
+        len: usize,
+        frames: std::ops::Range<usize>,
+        band: (f64, f64),
+    ) -> Vec<(f64, f64)> {
         let n = self.window_len();
         let half = n / 2;
         let step = self.step_len();
-        let frames = self.frame_count(x.len());
-        // segment of x covered by frame i, and where it starts inside the frame
+        let x = block;
+        // segment of the block covered by frame i, and where it starts inside the frame
         let segment = move |i: usize| {
             let start = (i * step) as isize - half as isize;
             let lo = start.max(0) as usize;
-            let hi = ((start + n as isize).max(0) as usize).min(x.len());
-            (lo.min(hi), hi, (lo as isize - start) as usize)
+            let hi = ((start + n as isize).max(0) as usize).min(len);
+            let lo = lo.min(hi);
+            (
+                lo - block_start,
+                hi - block_start,
+                (lo as isize - start) as usize,
+            )
         };
         let nfft = match self.peak {
             PeakMethod::Paper => (self.fs / self.paper_bin_hz).round() as usize,
@@ -130,7 +165,7 @@ impl StftTracker {
         let k_hi = ((band.1 / df).floor() as usize).min(nfft / 2 - 1);
         let fs = self.fs;
         let peak = self.peak;
-        (0..frames)
+        frames
             .into_par_iter()
             .map_init(
                 || {

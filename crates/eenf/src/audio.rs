@@ -9,6 +9,8 @@ use std::process::{Command, Stdio};
 
 use crate::error::{error, fail, Context, Error, Result};
 use eenf_dsp::StreamDecimator;
+
+use crate::spool::{Spool, SpoolWriter};
 use symphonia::core::audio::SampleBuffer;
 use symphonia::core::codecs::{DecoderOptions, CODEC_TYPE_NULL};
 use symphonia::core::errors::Error as SymError;
@@ -62,10 +64,11 @@ pub struct AudioOptions {
 }
 
 /// A recording's sound, as read.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Audio {
-    /// The mono signal (decimated as asked).
-    pub signal: Signal,
+    /// The mono signal (decimated as asked), on disk: memory stays the same whatever the
+    /// recording's length.
+    pub signal: Spool,
     /// The recording's own sample rate, Hz.
     pub source_rate: f64,
     /// Its channels.
@@ -85,6 +88,7 @@ struct Sink {
     decimator: StreamDecimator,
     mono: Vec<f64>,
     out: Vec<f64>,
+    spool: SpoolWriter,
     frames: u64,
 }
 
@@ -98,18 +102,22 @@ impl Sink {
                 );
             }
         }
+        // no band above Nyquist: passes through
+        let decimator = StreamDecimator::new(fs, top_hz.unwrap_or(fs));
+        // the decimator's delay taken back out, so sample 0 is the recording's start
+        let lag = (decimator.delay_s() * decimator.fs_out()).round() as usize;
         Ok(Sink {
             channel,
             channels,
-            // no band above Nyquist: passes through
-            decimator: StreamDecimator::new(fs, top_hz.unwrap_or(fs)),
+            spool: SpoolWriter::new(decimator.fs_out())?.skip(lag),
+            decimator,
             mono: Vec::new(),
             out: Vec::new(),
             frames: 0,
         })
     }
 
-    fn push(&mut self, interleaved: &[f32]) {
+    fn push(&mut self, interleaved: &[f32]) -> Result<()> {
         let ch = self.channels.max(1);
         self.mono.clear();
         match self.channel {
@@ -124,32 +132,38 @@ impl Sink {
             ),
         }
         self.frames += self.mono.len() as u64;
+        self.out.clear();
         self.decimator.push(&self.mono, &mut self.out);
+        self.spool.push(&self.out)
     }
 }
 
 impl Audio {
     /// The signal brought down further, to the lowest rate that keeps every band up to
-    /// `top_hz` (the same streaming FIR decimation, its delay taken back out); unchanged when
-    /// no lower rate does.
-    pub fn narrowed(&self, top_hz: f64) -> Signal {
+    /// `top_hz` (the same streaming FIR decimation, its delay taken back out), read and
+    /// written a block at a time; `None` when no lower rate does.
+    pub fn narrowed(&self, top_hz: f64) -> Result<Option<Spool>> {
         let mut d = StreamDecimator::new(self.signal.fs, top_hz);
         if d.factor() <= 1 {
-            return self.signal.clone();
+            return Ok(None);
         }
-        let mut samples = Vec::with_capacity(self.signal.samples.len() / d.factor() + 1);
-        d.push(&self.signal.samples, &mut samples);
         let lag = (d.delay_s() * d.fs_out()).round() as usize;
-        // the tail the delay held back: flush it with zeros, then drop the delay in front
-        let tail = lag * d.factor() + d.factor();
-        d.push(&vec![0.0; tail], &mut samples);
-        let want = self.signal.samples.len().div_ceil(d.factor());
-        samples.drain(..lag.min(samples.len()));
-        samples.truncate(want);
-        Signal {
-            fs: d.fs_out(),
-            samples,
+        let want = self.signal.len().div_ceil(d.factor());
+        let mut out = SpoolWriter::new(d.fs_out())?.skip(lag).limit(want);
+        let mut samples = Vec::new();
+        const BLOCK: usize = 1 << 20;
+        for lo in (0..self.signal.len()).step_by(BLOCK) {
+            let block = self.signal.read(lo..(lo + BLOCK).min(self.signal.len()))?;
+            samples.clear();
+            d.push(&block, &mut samples);
+            out.push(&samples)?;
         }
+        // the tail the delay held back: flushed with zeros
+        let tail = lag * d.factor() + d.factor();
+        samples.clear();
+        d.push(&vec![0.0; tail], &mut samples);
+        out.push(&samples)?;
+        out.finish().map(Some)
     }
 }
 
@@ -297,7 +311,7 @@ pub fn audio_from_samples(
     let mut sink = Sink::new(opts.channel, channels, fs, opts.top_hz)?;
     // fed in blocks as a decoder's packets would be
     for block in interleaved.chunks(channels * 4096) {
-        sink.push(block);
+        sink.push(block)?;
     }
     finish(Some(sink), fs, name, "memory", None)
 }
@@ -388,7 +402,7 @@ fn read_symphonia(
         b.copy_interleaved_ref(decoded);
         if let Some(s) = sink.as_mut() {
             if s.channels == channels {
-                s.push(b.samples());
+                s.push(b.samples()).map_err(Unreadable::Other)?;
             }
         }
     }
@@ -411,15 +425,8 @@ fn finish(
     let Some(s) = sink.filter(|s| s.frames > 0) else {
         fail!(Input, "{}: the recording holds no sound", path.display());
     };
-    // the decimator's delay taken back out, so sample 0 is the recording's start
-    let lag = (s.decimator.delay_s() * s.decimator.fs_out()).round() as usize;
-    let mut samples = s.out;
-    samples.drain(..lag.min(samples.len()));
     Ok(Audio {
-        signal: Signal {
-            fs: s.decimator.fs_out(),
-            samples,
-        },
+        signal: s.spool.finish()?,
         source_rate: fs,
         channels: s.channels,
         frames: s.frames,
@@ -546,7 +553,7 @@ fn decode_ffmpeg_output(
                 .chunks_exact(4)
                 .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
         );
-        sink.push(&frame);
+        sink.push(&frame)?;
         bytes.copy_within(whole..have, 0);
         carry = have - whole;
     }
@@ -560,5 +567,9 @@ pub fn read_wav(path: &Path) -> Result<Signal> {
         channel: Channel::Index(0),
         top_hz: None,
     };
-    Ok(read_audio(path, &opts)?.signal)
+    let signal = read_audio(path, &opts)?.signal;
+    Ok(Signal {
+        fs: signal.fs,
+        samples: signal.to_vec()?,
+    })
 }

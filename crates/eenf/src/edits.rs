@@ -296,14 +296,15 @@ pub fn sound_baseband(sound: &Sound, audio: &AudioOptions, nominal: Nominal) -> 
         top_hz: Some(top_of(MAX_HUM_HARMONIC)),
         ..*audio
     })?;
-    let duration_s = a.signal.samples.len() as f64 / a.signal.fs;
+    let duration_s = a.signal.duration_s();
     if duration_s < MIN_CLIP_S {
         return Err(err(eenf_dsp::DspError::TooShort {
             duration_s,
             window_s: MIN_CLIP_S,
         }));
     }
-    let search = search_hum(&a.signal.samples, a.signal.fs, 1.0, grids, MAX_HUM_HARMONIC)
+    let search = eenf_dsp::hum::search_hum_in(&a.signal, a.signal.fs, 1.0, grids, MAX_HUM_HARMONIC)
+        .map_err(err)?
         .ok_or_else(|| {
             error!(Method,
                 "{}: sample rate {} Hz is too low to carry a mains line with its noise floor beside it",
@@ -315,10 +316,11 @@ pub fn sound_baseband(sound: &Sound, audio: &AudioOptions, nominal: Nominal) -> 
     let mut carriers = verdict.carriers.clone();
     carriers.sort_unstable();
     let highest = carriers.last().copied().unwrap_or(1);
-    let sig = a.narrowed(top_of(highest));
+    let narrowed = a.narrowed(top_of(highest))?;
+    let sig = narrowed.as_ref().unwrap_or(&a.signal);
     let multiples: Vec<u32> = carriers.iter().map(|&k| k as u32).collect();
     Ok(SoundHum {
-        baseband: baseband(&sig.samples, sig.fs, verdict.grid_hz, &multiples),
+        baseband: baseband(&sig.to_vec()?, sig.fs, verdict.grid_hz, &multiples),
         duration_s,
         warning: a.warning,
     })

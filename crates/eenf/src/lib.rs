@@ -45,6 +45,7 @@ pub mod recording;
 pub mod refdb;
 pub mod reference;
 pub mod simulation;
+pub mod spool;
 pub mod time;
 pub mod trace;
 pub mod video;

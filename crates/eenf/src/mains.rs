@@ -4,11 +4,10 @@
 use std::path::Path;
 
 use crate::error::{error, fail, Error, Missing, Result};
+use eenf_dsp::blocks::{enf_from_hum_lines_in, reference_enf_in, BlockSource};
+use eenf_dsp::hum::search_hum_in;
 use eenf_dsp::hum::{MAX_HUM_HARMONIC, MIN_CLIP_S};
-use eenf_dsp::{
-    check_holds_line, choose_window, enf_from_hum_lines, plausibility, reference_enf_with_snr,
-    search_hum, EnfParams,
-};
+use eenf_dsp::{check_holds_line, choose_window, plausibility, EnfParams};
 
 use crate::audio::{AudioOptions, Sound};
 use crate::trace::{AudioProvenance, HumReport, MainsProvenance, Provenance, Trace};
@@ -17,23 +16,35 @@ use eenf_core::{Grid, Nominal};
 
 /// Decides or checks the nominal frequency of a mains signal: the line detector on f0 alone.
 pub fn mains_nominal(sig: &Signal, nominal: Nominal, path: &Path) -> Result<Grid> {
+    mains_nominal_in(&sig.samples.as_slice(), sig.fs, nominal, path)
+}
+
+/// [`mains_nominal`] of a signal at `fs` read a block at a time.
+pub fn mains_nominal_in(
+    sig: &dyn BlockSource,
+    fs: f64,
+    nominal: Nominal,
+    path: &Path,
+) -> Result<Grid> {
     let err = |e: eenf_dsp::DspError| Error::from(e).context(path.display());
     let grids = grids_of(nominal);
     let top = grids.iter().fold(0.0f64, |a, &b| a.max(b));
-    if sig.fs < 2.0 * (top + 8.0) {
+    if fs < 2.0 * (top + 8.0) {
         fail!(
             Method,
             "{}: sample rate {} Hz is too low to carry a {top} Hz mains tone",
             path.display(),
-            sig.fs
+            fs
         );
     }
-    let search = search_hum(&sig.samples, sig.fs, 1.0, grids, 1).ok_or_else(|| {
-        err(eenf_dsp::DspError::TooShort {
-            duration_s: sig.samples.len() as f64 / sig.fs,
-            window_s: 1.0,
-        })
-    })?;
+    let search = search_hum_in(sig, fs, 1.0, grids, 1)
+        .map_err(err)?
+        .ok_or_else(|| {
+            err(eenf_dsp::DspError::TooShort {
+                duration_s: sig.len() as f64 / fs,
+                window_s: 1.0,
+            })
+        })?;
     grid_of_verdict(search.verdict().map_err(err)?.grid_hz, path)
 }
 
@@ -163,17 +174,16 @@ pub fn sound_trace(
         channel: audio.channel.to_string(),
         frames: a.frames,
     };
-    let duration_s = a.signal.samples.len() as f64 / a.signal.fs;
+    let duration_s = a.signal.duration_s();
     if let MainsLines::UpTo(1) = hum.lines {
         // the method's reference tracker: f0 alone, unfiltered
-        let f0 = mains_nominal(&a.signal, nominal, path)?;
+        let f0 = mains_nominal_in(&a.signal, a.signal.fs, nominal, path)?;
         let p = EnfParams {
             nominal_hz: f0.hz(),
             window_s: hum.window_s.unwrap_or(params.window_s),
             ..params.clone()
         };
-        let (enf, snr_db) =
-            reference_enf_with_snr(&a.signal.samples, a.signal.fs, &p).map_err(err)?;
+        let (enf, snr_db) = reference_enf_in(&a.signal, a.signal.fs, &p).map_err(err)?;
         let mut t = Trace::from_mains(path, f0, &p, enf);
         t.snr_db = snr_db;
         if let Some(Provenance::Mains(m)) = t.provenance.as_mut() {
@@ -191,14 +201,16 @@ pub fn sound_trace(
             window_s: MIN_CLIP_S,
         }));
     }
-    let search = search_hum(&a.signal.samples, a.signal.fs, 1.0, grids, most).ok_or_else(|| {
-        error!(
-            Method,
-            "{}: sample rate {} Hz is too low to carry a mains line with its noise floor beside it",
-            path.display(),
-            a.signal.fs
-        )
-    })?;
+    let search = search_hum_in(&a.signal, a.signal.fs, 1.0, grids, most)
+        .map_err(err)?
+        .ok_or_else(|| {
+            error!(
+                Method,
+                "{}: sample rate {} Hz is too low to carry a mains line with its noise floor beside it",
+                path.display(),
+                a.signal.fs
+            )
+        })?;
     let verdict = search.verdict().map_err(err)?;
     let grid = grid_of_verdict(verdict.grid_hz, path)?;
     let f0 = grid.hz();
@@ -219,7 +231,8 @@ pub fn sound_trace(
         verdict.carriers.clone()
     };
     let highest = carriers.iter().copied().max().unwrap_or(1);
-    let sig = a.narrowed(top_of(highest));
+    let narrowed = a.narrowed(top_of(highest))?;
+    let sig = narrowed.as_ref().unwrap_or(&a.signal);
     let p = EnfParams {
         nominal_hz: f0,
         harmonics: highest,
@@ -228,13 +241,13 @@ pub fn sound_trace(
     };
     let edge = (window_s / 2.0 / p.step_s).ceil() as usize;
     let mut trace = if f0_alone {
-        let (enf, snr_db) = reference_enf_with_snr(&sig.samples, sig.fs, &p).map_err(err)?;
+        let (enf, snr_db) = reference_enf_in(sig, sig.fs, &p).map_err(err)?;
         Trace {
             snr_db,
             ..Trace::from_mains(path, grid, &p, enf)
         }
     } else {
-        let estimates = enf_from_hum_lines(&sig.samples, sig.fs, &p, &carriers).map_err(err)?;
+        let estimates = enf_from_hum_lines_in(sig, sig.fs, &p, &carriers).map_err(err)?;
         Trace::from_mains_lines(
             path,
             grid,

@@ -3,6 +3,7 @@
 //! compiling it a second time in test mode (a minute of a fresh clone's wait).
 
 mod scipy_golden;
+mod unit_blocks;
 mod unit_chirp;
 mod unit_decimate;
 mod unit_edits;
