@@ -453,18 +453,8 @@ pub fn reference_enf_with_snr(
     fs: f64,
     p: &EnfParams,
 ) -> Result<(Vec<f64>, Vec<f64>), DspError> {
-    check_reference(x.len(), fs, p)?;
-    let band = (p.nominal_hz - p.half_band_hz, p.nominal_hz + p.half_band_hz);
-    let (enf, snr_db): (Vec<f64>, Vec<f64>) =
-        p.tracker(fs).track_with_snr(x, band).into_iter().unzip();
-    if enf.iter().all(|v| !v.is_finite()) {
-        return Err(DspError::NoTone(format!(
-            "no line inside {:.2}-{:.2} Hz (each window's peak sat at the band's edge)",
-            band.0, band.1
-        )));
-    }
-    check_near_nominal(&enf, p.nominal_hz)?;
-    Ok((enf, snr_db))
+    // the block path over the slice: one tracker and one set of checks for both
+    crate::blocks::reference_enf_in(&x, fs, p)
 }
 
 /// What [`reference_enf_with_snr`] needs of a signal of `len` samples at `fs`: a window's

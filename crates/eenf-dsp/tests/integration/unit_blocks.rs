@@ -2,7 +2,7 @@
 //! tracked whole.
 
 use eenf_dsp::blocks::{enf_from_hum_lines_in, reference_enf_in, BlockSource};
-use eenf_dsp::{enf_from_hum_lines, reference_enf_with_snr, DspError, EnfParams};
+use eenf_dsp::{enf_from_hum_lines, DspError, EnfParams};
 
 use crate::test_noise as noise;
 
@@ -72,7 +72,10 @@ fn blocks_give_what_the_whole_signal_gives() {
             );
         }
     }
-    let (enf, snr) = reference_enf_with_snr(&x, fs, &p).unwrap();
+    // f0 alone, unfiltered: the tracker over the whole signal
+    let band = (p.nominal_hz - p.half_band_hz, p.nominal_hz + p.half_band_hz);
+    let (enf, snr): (Vec<f64>, Vec<f64>) =
+        p.tracker(fs).track_with_snr(&x, band).into_iter().unzip();
     let (enf_b, snr_b) = reference_enf_in(&src, fs, &p).unwrap();
     assert_eq!(enf, enf_b);
     assert_eq!(snr, snr_b);
