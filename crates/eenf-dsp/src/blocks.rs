@@ -68,6 +68,23 @@ pub fn enf_from_hum_lines_in(
     finish_bands(tracks, fs, p, 1.0)
 }
 
+/// The reference ENF of a mains (or audio) signal: the same tracker at the fundamental f0,
+/// searched within f0 ± `half_band_hz`. No filtering, as in the method's definition.
+pub fn reference_enf(x: &[f64], fs: f64, p: &EnfParams) -> Result<Vec<f64>, DspError> {
+    reference_enf_with_snr(x, fs, p).map(|(enf, _)| enf)
+}
+
+/// [`reference_enf`], with each window's line strength over its band's median, dB (see
+/// [`StftTracker::track_with_snr`]).
+pub fn reference_enf_with_snr(
+    x: &[f64],
+    fs: f64,
+    p: &EnfParams,
+) -> Result<(Vec<f64>, Vec<f64>), DspError> {
+    // the block path over the slice: one tracker and one set of checks for both
+    reference_enf_in(&x, fs, p)
+}
+
 /// [`crate::reference_enf_with_snr`] (f0 alone, unfiltered) over a signal read a block at a
 /// time.
 pub fn reference_enf_in(

@@ -440,24 +440,7 @@ pub fn audibility(harmonics: &[HarmonicEstimates], segment: usize) -> Vec<Vec<bo
         .collect()
 }
 
-/// The reference ENF of a mains (or audio) signal: the same tracker at the fundamental f0,
-/// searched within f0 ± `half_band_hz`. No filtering, as in the method's definition.
-pub fn reference_enf(x: &[f64], fs: f64, p: &EnfParams) -> Result<Vec<f64>, DspError> {
-    reference_enf_with_snr(x, fs, p).map(|(enf, _)| enf)
-}
-
-/// [`reference_enf`], with each window's line strength over its band's median, dB (see
-/// [`StftTracker::track_with_snr`]).
-pub fn reference_enf_with_snr(
-    x: &[f64],
-    fs: f64,
-    p: &EnfParams,
-) -> Result<(Vec<f64>, Vec<f64>), DspError> {
-    // the block path over the slice: one tracker and one set of checks for both
-    crate::blocks::reference_enf_in(&x, fs, p)
-}
-
-/// What [`reference_enf_with_snr`] needs of a signal of `len` samples at `fs`: a window's
+/// What the reference tracker (`reference_enf_with_snr`) needs of a signal of `len` samples at `fs`: a window's
 /// length, and f0's band below the Nyquist frequency.
 pub(crate) fn check_reference(len: usize, fs: f64, p: &EnfParams) -> Result<(), DspError> {
     let duration_s = len as f64 / fs;

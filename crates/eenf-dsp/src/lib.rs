@@ -36,13 +36,14 @@ pub mod sampling;
 pub mod spectrogram;
 pub mod tracker;
 
+pub use blocks::{reference_enf, reference_enf_with_snr};
 pub use butter::{butter_bandpass, butter_lowpass, sos_to_ba, Section};
 pub use chirp::follow_chirps;
 pub use decimate::{decimate, decimation_for, StreamDecimator};
 pub use enf::{
     check_line, detect_nominal, enf_from_flicker, enf_from_harmonics, enf_from_hum_lines,
-    enf_from_lines, extract_enf, line_prominence, reference_enf, reference_enf_with_snr, DspError,
-    EnfEstimates, EnfParams, HarmonicEstimates,
+    enf_from_lines, extract_enf, line_prominence, DspError, EnfEstimates, EnfParams,
+    HarmonicEstimates,
 };
 pub use filtfilt::sosfiltfilt;
 pub use flicker::{
