@@ -7,11 +7,14 @@ Three parts, each run on inputs written here into target/scale-bench/ (kept betw
                        each span at 1 s (default 1,10), and with --grids 3 over three grids;
                        says whether the right second came first;
   month                `eenf refdb build` adding a month (an ESO `dtm,f` CSV) to a copy of the
-                       ten-year store.
-Stores are written directly in the store's format (refdb.rs: i32 µHz, CRC-32 in the manifest):
+                       ten-year store;
+  libhum DAYS,...      libhum 1.1.5's `match_signals` (numpy backend, its only one without a GPU)
+                       and `eenf match` on the same 5 min trace over the first DAYS of the same
+                       store (default 1,7), each with a time limit of 900 s.
+Stores are written directly in the store's format (refdb: parts of i32 µHz with their CRC-32):
 a random walk held near 50 Hz, 2 mHz a step, like a grid's one-second means.
 
-Usage: python tools/scale_bench.py audio [MINUTES] | match [YEARS] [--grids N] | month
+Usage: python tools/scale_bench.py audio [MINUTES] | match [YEARS] [--grids N] | month | libhum [DAYS]
 Needs: numpy; /usr/bin/time; a release build of eenf (cargo build --release)."""
 import csv
 import json
@@ -28,7 +31,7 @@ root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 out = os.path.join(root, "target", "scale-bench")
 eenf = os.path.join(root, "target", "release", "eenf")
 START = 1451606400  # 2016-01-01T00:00:00Z
-CHUNK = 10_000_000
+PART = 1 << 22  # values per part (refdb's PART_VALUES)
 
 
 def timed(cmd):
@@ -88,49 +91,64 @@ def audio(minutes_list):
 
 
 def store(name, years, seed):
-    """A store folder holding one grid `name` over `years` at 1 s; its folder."""
+    """A store folder holding one grid `name` over `years` at 1 s; its folder. Written in the
+    store's layout: parts of 2^22 values counted from the Unix epoch, each with its CRC-32."""
     d = os.path.join(out, f"store-{name}-{years:g}y")
     manifest = os.path.join(d, f"{name}.json")
     if os.path.exists(manifest):
         return d
     os.makedirs(d, exist_ok=True)
     count = int(years * 365.25 * 86400)
-    values = f"{name}.bench.i32"
     rng = np.random.default_rng(seed)
-    x, crc = 0.0, 0
-    with open(os.path.join(d, values), "wb") as f:
-        for lo in range(0, count, CHUNK):
-            n = min(CHUNK, count - lo)
-            steps = rng.normal(0, 2e-3, n)
-            walk = np.empty(n)
-            for i0 in range(0, n, 100_000):  # held near nominal: x ← 0.999 x + step
-                seg = steps[i0:i0 + 100_000]
-                k = np.arange(len(seg))
-                w = 0.999 ** k
-                walk[i0:i0 + len(seg)] = w * (x * 0.999 + np.cumsum(seg / w))
-                x = walk[i0 + len(seg) - 1]
-            b = np.round(walk * 1e6).astype("<i4").tobytes()
-            crc = zlib.crc32(b, crc)
+    x, parts = 0.0, []
+    lo = 0
+    while lo < count:
+        n = min(PART - (START + lo) % PART, count - lo)
+        steps = rng.normal(0, 2e-3, n)
+        walk = np.empty(n)
+        for i0 in range(0, n, 100_000):  # held near nominal: x ← 0.999 x + step
+            seg = steps[i0:i0 + 100_000]
+            k = np.arange(len(seg))
+            w = 0.999 ** k
+            walk[i0:i0 + len(seg)] = w * (x * 0.999 + np.cumsum(seg / w))
+            x = walk[i0 + len(seg) - 1]
+        b = np.round(walk * 1e6).astype("<i4").tobytes()
+        file = f"{name}.bench{len(parts):05d}.0.i32"
+        with open(os.path.join(d, file), "wb") as f:
             f.write(b)
+        parts.append({"file": file, "first": lo, "count": n, "crc32": zlib.crc32(b)})
+        lo += n
     meta = {"grid": name, "nominal_hz": 50.0, "step_s": 1.0, "start_unix_s": float(START),
             "count": count, "encoding": "i32 little-endian, µHz deviation from nominal_hz, "
-            "-2147483648 = gap", "values_file": values, "values_crc32": crc}
+            "-2147483648 = gap", "parts": parts}
     with open(manifest, "w") as f:
         json.dump(meta, f)
     return d
 
 
+def stored(d, name, at, n):
+    """Values at..at+n of the grid `name` in the store at d, µHz."""
+    meta = json.load(open(os.path.join(d, f"{name}.json")))
+    out = []
+    for p in meta["parts"]:
+        a, b = max(at, p["first"]), min(at + n, p["first"] + p["count"])
+        if a < b:
+            v = np.memmap(os.path.join(d, p["file"]), dtype="<i4", mode="r")
+            out.append(np.asarray(v[a - p["first"]:b - p["first"]]))
+    return np.concatenate(out)
+
+
 def cut(d, name, at, seconds, path):
     """A trace of `seconds` from the store's grid at second `at`, with 1 mHz of noise."""
-    v = np.memmap(os.path.join(d, f"{name}.bench.i32"), dtype="<i4", mode="r")
-    hz = 50 + v[at:at + seconds].astype(float) / 1e6
+    hz = 50 + stored(d, name, at, seconds).astype(float) / 1e6
     hz += np.random.default_rng(at).normal(0, 1e-3, seconds)
     np.savetxt(path, np.c_[np.arange(seconds), hz], delimiter=",", header="time_s,enf_hz",
                comments="", fmt="%.6f")
 
 
 def match(years_list, grids):
-    print("| match | store | wall s | peak MB | right second first |\n|---|---|---|---|---|")
+    print("| match | store | wall s | peak MB | right second and grid first |\n"
+          "|---|---|---|---|---|")
     for years in years_list:
         names = ["DE", "FR", "PL"][:grids]
         dirs = [store(n, years, seed) for seed, n in enumerate(names)]
@@ -139,8 +157,8 @@ def match(years_list, grids):
             d = os.path.join(out, f"store-{grids}grids-{years:g}y")
             os.makedirs(d, exist_ok=True)
             for n, src in zip(names, dirs):
-                for f in (f"{n}.json", f"{n}.bench.i32"):
-                    if not os.path.exists(os.path.join(d, f)):
+                for f in os.listdir(src):
+                    if f.startswith(n + ".") and not os.path.exists(os.path.join(d, f)):
                         os.link(os.path.join(src, f), os.path.join(d, f))
         at = int(years * 365.25 * 86400 * 0.73)
         for seconds in (300, 3600):
@@ -148,19 +166,38 @@ def match(years_list, grids):
             cut(dirs[-1], names[-1], at, seconds, trace)
             wall, mb, text = timed([eenf, "-q", "match", trace, d, "--json"])
             found = json.loads(text)
-            best = found["candidates"][0] if "candidates" in found else found
-            right = abs(best.get("start_unix_s", START + best.get("offset_s", -1)) - (START + at))
+            best = found["candidates"][0]
+            right = abs(best["start_s"] - (START + at)) < 1 and best["grid"] == names[-1]
             print(f"| {seconds // 60} min | {grids} grid(s) × {years:g} y | {wall:.1f} | {mb:.0f} "
-                  f"| {'yes' if right < 1 else 'no (' + str(best)[:80] + ')'} |", flush=True)
+                  f"| {'yes' if right else 'no'} ({best['grid']}, p {best['p_value']:.1e}) |",
+                  flush=True)
 
 
 def month():
+    """A month added at the end of a store of ten years less that month (a store may span ten
+    years): the build reads and rewrites only the parts the month touches."""
     src = store("DE", 10, 0)
     d = os.path.join(out, "store-month")
     shutil.rmtree(d, ignore_errors=True)
     shutil.copytree(src, d)
-    meta = json.load(open(os.path.join(d, "DE.json")))
-    t0 = START + meta["count"] - 31 * 86400 // 2  # half inside, half past the end
+    manifest = os.path.join(d, "DE.json")
+    meta = json.load(open(manifest))
+    keep = meta["count"] - 31 * 86400
+    parts = []
+    for p in meta["parts"]:
+        path = os.path.join(d, p["file"])
+        if p["first"] >= keep:
+            os.remove(path)
+            continue
+        if p["first"] + p["count"] > keep:
+            p["count"] = keep - p["first"]
+            with open(path, "r+b") as f:
+                f.truncate(p["count"] * 4)
+            p["crc32"] = zlib.crc32(open(path, "rb").read())
+        parts.append(p)
+    meta.update(count=keep, parts=parts)
+    json.dump(meta, open(manifest, "w"))
+    t0 = START + keep
     rng = np.random.default_rng(9)
     hz = 50 + rng.normal(0, 0.02, 31 * 86400)
     path = os.path.join(out, "month.csv")
@@ -169,8 +206,61 @@ def month():
         for i, v in enumerate(hz):
             t = np.datetime64(int(t0 + i), "s")
             f.write(f"{str(t).replace('T', ' ')},{v:.3f}\n")
+    before = set(os.listdir(d))
     wall, mb, _ = timed([eenf, "-q", "refdb", "build", d, path, "--grid", "DE"])
-    print(f"| a month added to 10 y | {wall:.1f} s | {mb:.0f} MB |")
+    after = set(os.listdir(d))
+    print(f"| a month added to 10 y less a month | {wall:.1f} s | {mb:.0f} MB | "
+          f"{len(after - before)} part files written, {len(before - after)} removed, "
+          f"{len(before & after) - 2} untouched |")
+
+
+LIBHUM = """
+import sys, time, numpy as np
+from libhum.types import Signal
+from libhum.match import match_signals
+ref = np.fromfile(sys.argv[1], dtype="<i4").astype(np.float32) / 1e6
+clip = np.loadtxt(sys.argv[2], delimiter=",", skiprows=1)[:, 1] - 50
+sig = lambda x: Signal(50.0, 1.0, np.ma.masked_invalid(x.astype(np.float32)))
+t = time.time()
+m = match_signals(sig(ref), sig(clip), max_matches=1)
+print(time.time() - t, m[0].offset.total_seconds() if m else "none")
+"""
+
+
+def libhum(days_list):
+    """libhum and eenf on the same trace and the same span of the store's values."""
+    src = store("DE", 1, 0)
+    at = 3 * 3600 + 1234  # inside the first day
+    trace = os.path.join(out, "cut-libhum-300.csv")
+    cut(src, "DE", at, 300, trace)
+    print("| span | libhum 1.1.5 (numpy) | eenf match |\n|---|---|---|")
+    for days in days_list:
+        n = int(days * 86400)
+        raw = os.path.join(out, f"libhum-{days:g}d.i32")
+        stored(src, "DE", 0, n).astype("<i4").tofile(raw)
+        d = os.path.join(out, f"store-DE-{days:g}d")
+        shutil.rmtree(d, ignore_errors=True)
+        os.makedirs(d)
+        csv_path = os.path.join(out, f"libhum-{days:g}d.csv")
+        with open(csv_path, "w") as f:
+            f.write("time_s,enf_hz\n")
+            np.savetxt(f, np.c_[np.arange(n), 50 + np.fromfile(raw, "<i4") / 1e6], delimiter=",",
+                       fmt=["%d", "%.6f"])
+        subprocess.run([eenf, "-q", "refdb", "build", d, f"{csv_path}@2016-01-01T00:00:00Z",
+                        "--grid", "DE"], check=True, capture_output=True)
+        try:
+            r = subprocess.run(["/usr/bin/time", "-f", "%e %M", sys.executable, "-c", LIBHUM, raw,
+                                trace], capture_output=True, text=True, timeout=900)
+            secs, where = r.stdout.split()[:2]
+            peak = int(r.stderr.strip().splitlines()[-1].split()[1]) / 1024
+            theirs = f"{float(secs):.1f} s, {peak:.0f} MB, {'right' if where != 'none' and abs(float(where) - at) < 1 else 'wrong'} second"
+        except subprocess.TimeoutExpired:
+            theirs = "no answer in 900 s"
+        wall, mb, text = timed([eenf, "-q", "match", trace, d, "--json"])
+        best = json.loads(text)["candidates"][0]
+        ok = abs(best["start_s"] - (START + at)) < 1
+        print(f"| {days:g} d | {theirs} | {wall:.2f} s, {mb:.0f} MB, "
+              f"{'right' if ok else 'wrong'} second |", flush=True)
 
 
 if __name__ == "__main__":
@@ -184,5 +274,7 @@ if __name__ == "__main__":
         match([float(y) for y in (arg or "1,10").split(",")], grids)
     elif what == "month":
         month()
+    elif what == "libhum":
+        libhum([float(d) for d in (arg or "1,7").split(",")])
     else:
         sys.exit(__doc__)

@@ -79,7 +79,7 @@ def trace_seeds(binary, work):
     if r.returncode != 0 or out.returncode != 0:
         sys.exit(f"could not make the trace seeds: {r.stderr.strip()}")
     manifest = os.path.join(store, "grid50.json")
-    values = os.path.join(store, json.load(open(manifest))["values_file"])
+    values = os.path.join(store, json.load(open(manifest))["parts"][0]["file"])
     as_trace = {"match-trace": ["match", "{}", seed_csv], "match-reference": ["match", clip, "{}"],
                 "compare": ["compare", "{}", clip]}
     as_store = {"refdb-info": ["refdb", "info", "{}"], "match-store": ["match", clip, "{}"]}

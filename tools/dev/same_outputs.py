@@ -68,7 +68,7 @@ VOLATILE = [
     (rb"in \d+(\.\d+)? (s|ms)\b", b"in T s"),
     (rb"\d+(\.\d+)? M events/s", b"R M events/s"),
     (rb'"(elapsed_s|seconds|wall_s)": [0-9.e-]+', rb'"\1": T'),
-    (rb"\.[0-9a-f]{16}\.\d+\.i32", b".ID.i32"),
+    (rb"\.[0-9a-f]{16,}\.\d+\.i32", b".ID.i32"),
 ]
 
 

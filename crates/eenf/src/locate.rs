@@ -176,7 +176,7 @@ impl MatchReport {
             .iter()
             .map(|p| {
                 let (r, c) = (&refs[p.series], &p.candidate);
-                serde_json::json!({"reference": r.name, "start": r.time_label(c.offset),
+                serde_json::json!({"reference": r.name, "grid": r.grid, "start": r.time_label(c.offset),
                     "start_s": r.start + c.offset * r.step, "offset_steps": c.offset,
                     "cc": c.agreement.cc, "mae_hz": c.agreement.mae_hz,
                     "rmse_hz": c.agreement.rmse_hz, "overlap": c.agreement.n,
@@ -185,10 +185,12 @@ impl MatchReport {
             .collect();
         serde_json::json!({
             "trace": trace, "nominal_hz": self.grid.hz(), "alpha": alpha, "seconds": self.seconds,
+            "searched": refs.iter().map(|r| &r.name).collect::<Vec<_>>(),
             "candidates": cands,
             "verify": self.verified.as_ref().map(|v| {
                 let (r, v) = (&refs[v.series], &v.verification);
                 serde_json::json!({
+                "reference": r.name, "grid": r.grid,
                 "time": r.time_label(v.offset as f64), "cc": v.agreement.cc,
                 "mae_hz": v.agreement.mae_hz, "rmse_hz": v.agreement.rmse_hz, "rank": v.rank, "p_value": v.p_value,
                 "best_fit": v.rank == 1, "consistent": v.rank == 1 && v.p_value < alpha})}),

@@ -6,7 +6,7 @@ use eenf_core::spelling::{option, option_with};
 use std::path::{Path, PathBuf};
 
 use crate::error::{fail, Error, Missing, Result};
-use eenf_dsp::matching::{match_trace, MatchError, MatchOptions, MatchResult, ScaledSeries};
+use eenf_dsp::matching::{match_trace, MatchError, MatchOptions, MatchResult, ReferenceValues};
 use eenf_dsp::{reference_enf, EnfParams};
 
 use crate::archive::{ArchiveImport, ArchiveOptions};
@@ -14,7 +14,7 @@ use crate::audio::read_wav;
 use crate::dataset::hourly_references;
 use crate::mains::{mains_nominal, reference_file};
 use crate::progress::Progress;
-use crate::refdb::{check_grid_name, StoreLock, StoredGrid, GAP};
+use crate::refdb::{check_grid_name, GridEdit, GridValues, StoreLock, StoredGrid};
 use crate::time::{LocalInstant, LocalTime, Zone};
 use crate::trace::Trace;
 use crate::wav::is_wav;
@@ -192,8 +192,10 @@ pub fn wav_start(path: &Path, zone: Option<&Zone>) -> Result<f64> {
 /// A long reference series that `match` searches: a store's grid, a folder of hourly WAVs, one
 /// WAV, or a trace.
 pub struct ReferenceSeries {
-    /// Its name in results.
+    /// Its name in results: the grid's, for a store's series; else the file's.
     pub name: String,
+    /// The store's grid it is, when it is one.
+    pub grid: Option<String>,
     /// Time of the first value: Unix seconds when `absolute`, else seconds of the trace.
     pub start: f64,
     /// Whether `start` is an absolute time.
@@ -208,34 +210,20 @@ pub struct ReferenceSeries {
     pub notes: Vec<String>,
 }
 
-/// Reference values: in Hz, or as stored (µHz from nominal), read in place.
+/// Reference values: in Hz in memory, or a store's grid read from its files where needed.
 pub enum SeriesValues {
     /// Frequencies, Hz (NaN = gap).
     Hz(Vec<f64>),
-    /// A store's integers.
-    Stored {
-        /// µHz from `nominal`, [`GAP`] = gap.
-        values: Vec<i32>,
-        /// The grid, Hz.
-        nominal: f64,
-    },
+    /// A store's grid, its checksums verified.
+    Stored(GridValues),
 }
 
 impl SeriesValues {
-    fn scaled(values: &[i32], nominal: f64) -> ScaledSeries<'_> {
-        ScaledSeries {
-            values,
-            offset_hz: nominal,
-            scale_hz: 1e-6,
-            gap: GAP,
-        }
-    }
-
     /// Number of values.
     pub fn len(&self) -> usize {
         match self {
             SeriesValues::Hz(v) => v.len(),
-            SeriesValues::Stored { values, .. } => values.len(),
+            SeriesValues::Stored(g) => g.meta.count,
         }
     }
 
@@ -244,22 +232,20 @@ impl SeriesValues {
         self.len() == 0
     }
 
-    /// Value `i`, Hz (NaN = gap).
-    pub fn get(&self, i: usize) -> f64 {
-        use eenf_dsp::matching::ReferenceValues;
+    /// Values `start .. start + n` in Hz (NaN = gap), as far as the series goes.
+    pub fn window(&self, start: usize, n: usize) -> Result<Vec<f64>> {
         match self {
-            SeriesValues::Hz(v) => v[i],
-            SeriesValues::Stored { values, nominal } => Self::scaled(values, *nominal).get(i),
+            SeriesValues::Hz(v) => v[..].window(start, n),
+            SeriesValues::Stored(g) => g.window(start, n),
         }
+        .map_err(Error::from)
     }
 
     /// Where `q` (at this series' step) fits.
     pub fn search(&self, q: &[f64], opts: &MatchOptions) -> Result<MatchResult, MatchError> {
         match self {
             SeriesValues::Hz(v) => match_trace(q, &v[..], opts),
-            SeriesValues::Stored { values, nominal } => {
-                match_trace(q, &Self::scaled(values, *nominal), opts)
-            }
+            SeriesValues::Stored(g) => match_trace(q, g, opts),
         }
     }
 }
@@ -304,17 +290,15 @@ impl ReferenceSeries {
                     if meta.nominal_hz != nominal {
                         continue; // 50 and 60 Hz are never mixed
                     }
-                    let s = StoredGrid::load(path, &g)?;
+                    let values = GridValues::open_checked(path, &g)?;
                     out.push(ReferenceSeries {
-                        name: g,
+                        name: g.clone(),
+                        grid: Some(g),
                         start: meta.start_unix_s,
                         absolute: true,
                         zone: zone.cloned(),
                         step: meta.step_s,
-                        values: SeriesValues::Stored {
-                            values: s.values,
-                            nominal,
-                        },
+                        values: SeriesValues::Stored(values),
                         notes: Vec::new(),
                     });
                 }
@@ -344,6 +328,7 @@ impl ReferenceSeries {
             }
             return Ok(vec![ReferenceSeries {
                 name: path.display().to_string(),
+                grid: None,
                 start: series.meta.start_unix_s,
                 absolute: true,
                 zone: zone.cloned(),
@@ -369,6 +354,7 @@ impl ReferenceSeries {
                 .map(|(i, piece)| ReferenceSeries {
                     notes: if i == 0 { notes.clone() } else { Vec::new() },
                     name: path.display().to_string(),
+                    grid: None,
                     start: piece.start,
                     absolute: true,
                     zone: zone.cloned(),
@@ -395,6 +381,7 @@ impl ReferenceSeries {
         };
         Ok(vec![ReferenceSeries {
             name: path.display().to_string(),
+            grid: None,
             start,
             absolute,
             zone: zone.cloned(),
@@ -484,7 +471,7 @@ pub fn build_store(
     // the whole read-merge-write under the store's lock: a second build waits for this one
     let _lock = StoreLock::exclusive(store, build.wait, on_wait)?;
     let bar = progress.steps(files.len() as u64, "adding references");
-    let mut series: Vec<StoredGrid> = Vec::new();
+    let mut series: Vec<GridEdit> = Vec::new();
     let mut next_start = build.start;
     let mut archives = Vec::new();
     for (path, at, archive) in &files {
@@ -534,9 +521,9 @@ pub fn build_store(
             Some(i) => i,
             None => {
                 let s = if store.join(format!("{grid}.json")).exists() {
-                    StoredGrid::load(store, &grid)?
+                    GridEdit::open(store, &grid)?
                 } else {
-                    StoredGrid::new(&grid, f0, step, start)
+                    GridEdit::new(store, &grid, f0, step, start)
                 };
                 series.push(s);
                 series.len() - 1
@@ -557,13 +544,11 @@ pub fn build_store(
     }
     bar.finish_and_clear();
     let mut built = Vec::new();
-    for s in &mut series {
-        s.save(store)?;
-        StoredGrid::remove_orphans(store, &s.meta.grid)?;
-        built.push(GridBuilt {
-            grid: s.meta.grid.clone(),
-            values: s.values.len(),
-        });
+    for s in series {
+        let grid = s.meta.grid.clone();
+        let values = s.commit()?;
+        StoredGrid::remove_orphans(store, &grid)?;
+        built.push(GridBuilt { grid, values });
     }
     Ok(StoreBuilt {
         grids: built,

@@ -60,7 +60,15 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         .map(|v| (&refs[v.series], &v.verification));
     let took = report.seconds;
     let step = trace.step_s;
-    let when = |r: &ReferenceSeries, offset: f64| r.time_label(offset);
+    // with several series searched (a store's grids), each place says which one
+    let many = refs.len() > 1;
+    let when = |r: &ReferenceSeries, offset: f64| {
+        if many {
+            format!("{} on {}", r.time_label(offset), r.name)
+        } else {
+            r.time_label(offset)
+        }
+    };
     if let (Some(p), Some((r, c))) = (&a.plot, rows.first()) {
         let k = c.offset.round() as usize;
         let n = trace.enf_hz.len().min(r.values.len().saturating_sub(k));
@@ -78,7 +86,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
             ),
             &t,
             &q[..n],
-            &(k..k + n).map(|i| r.values.get(i)).collect::<Vec<_>>(),
+            &r.values.window(k, n)?,
         )?;
         crate::terminal::announce("plot", p);
     }
@@ -88,10 +96,21 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         return Ok(());
     }
     outln!(
-        "{} ({} values, {} Hz grid) searched in {took:.2} s",
+        "{} ({} values, {} Hz grid) searched in {took:.2} s{}",
         a.trace.display(),
         trace.enf_hz.len(),
-        nominal
+        nominal,
+        if many {
+            format!(
+                " over {}",
+                refs.iter()
+                    .map(|r| r.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        } else {
+            String::new()
+        }
     );
     let labels: Vec<String> = rows.iter().map(|(r, c)| when(r, c.offset)).collect();
     let width = labels

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 use eenf::progress::Progress;
-use eenf::refdb::{StoreLock, StoredGrid, GAP};
+use eenf::refdb::{GridValues, StoreLock, StoredGrid};
 use eenf::reference::build_store;
 use eenf::time::{utc, Zone};
 
@@ -77,16 +77,10 @@ fn info(store: &Path, zone: Option<&Zone>) -> Result<()> {
     }
     let _lock = StoreLock::shared(store)?;
     for g in grids {
-        let s = StoredGrid::load(store, &g)?;
-        let m = &s.meta;
-        let gaps = s.values.iter().filter(|&&v| v == GAP).count();
-        let runs = s
-            .values
-            .windows(2)
-            .filter(|w| w[0] != GAP && w[1] == GAP)
-            .count()
-            + usize::from(s.values.first() == Some(&GAP));
-        let end = m.start_unix_s + (s.values.len().max(1) - 1) as f64 * m.step_s;
+        let values = GridValues::open(store, &g)?;
+        let s = values.check()?;
+        let m = &values.meta;
+        let end = m.start_unix_s + (s.values.max(1) - 1) as f64 * m.step_s;
         outln!("grid        {}", m.grid);
         outln!("nominal     {} Hz", m.nominal_hz);
         outln!("step        {} s", m.step_s);
@@ -98,17 +92,27 @@ fn info(store: &Path, zone: Option<&Zone>) -> Result<()> {
         outln!("to          {}", when(end));
         outln!(
             "values      {} ({:.1} % covered, {} gaps in {} runs)",
-            s.values.len(),
-            100.0 * (s.values.len() - gaps) as f64 / s.values.len().max(1) as f64,
-            gaps,
-            runs
+            s.values,
+            100.0 * (s.values - s.gaps) as f64 / s.values.max(1) as f64,
+            s.gaps,
+            s.gap_runs
         );
-        outln!("size        {:.1} MB", s.values.len() as f64 * 4.0 / 1e6);
+        outln!(
+            "size        {:.1} MB in {} part{}",
+            s.bytes as f64 / 1e6,
+            s.parts,
+            if s.parts == 1 { "" } else { "s" }
+        );
         outln!(
             "checksum    {}",
-            match m.values_crc32 {
-                Some(c) => format!("CRC-32 {c:08x}, verified"),
-                None => "none (a store written before checksums; build it again to add one)".into(),
+            if s.checksummed == s.parts {
+                "CRC-32 of each part, verified".to_string()
+            } else {
+                format!(
+                    "{} of {} parts without one (written before checksums; build it again to add them)",
+                    s.parts - s.checksummed,
+                    s.parts
+                )
             }
         );
         outln!();

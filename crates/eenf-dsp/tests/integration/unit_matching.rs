@@ -61,7 +61,7 @@ fn ffts_agree_with_direct_scores_including_gaps() {
     let mean = filled.iter().sum::<f64>() / filled.len() as f64;
     let q: Vec<f64> = filled.iter().map(|v| v - mean).collect();
     let r_mean = 50.0;
-    let cc = scores_all(&q, mean - r_mean, &reference[..], r_mean, 240, Score::Cc);
+    let cc = scores_all(&q, mean - r_mean, &reference[..], r_mean, 240, Score::Cc).unwrap();
     let comb = scores_all(
         &q,
         mean - r_mean,
@@ -69,9 +69,10 @@ fn ffts_agree_with_direct_scores_including_gaps() {
         r_mean,
         240,
         Score::Combined,
-    );
+    )
+    .unwrap();
     for k in [0, 1, 29_990, 30_010, 32_468, 32_469, 32_668, 65_437, 69_700] {
-        let a = score_offset(&filled, &reference[..], k).unwrap();
+        let a = score_offset(&filled, &reference[..], k).unwrap().unwrap();
         let (direct, direct_rmse) = (a.cc, a.rmse_hz);
         let gaps = reference[k..k + 300].iter().filter(|v| v.is_nan()).count();
         if 300 - gaps >= 240 {
@@ -147,4 +148,94 @@ fn best_offsets_equal_a_plain_greedy_pick() {
         );
     }
     assert!(best_offsets(&[f32::NAN; 10], 3, 2).is_empty());
+}
+
+/// A reference read only through `read`, noting the longest stretch asked for.
+struct Counted<'a> {
+    values: &'a [f64],
+    longest: std::sync::atomic::AtomicUsize,
+}
+
+impl ReferenceValues for Counted<'_> {
+    fn len(&self) -> usize {
+        self.values.len()
+    }
+    fn read(&self, start: usize, dst: &mut [f64]) -> Result<(), MatchError> {
+        self.longest
+            .fetch_max(dst.len(), std::sync::atomic::Ordering::Relaxed);
+        dst.copy_from_slice(&self.values[start..start + dst.len()]);
+        Ok(())
+    }
+}
+
+#[test]
+fn the_search_a_block_at_a_time_gives_the_exhaustive_answer() {
+    let mut reference = enf(400_000, 11);
+    for v in &mut reference[150_000..150_400] {
+        *v = f64::NAN;
+    }
+    let (at, m) = (271_828, 600);
+    let noise = enf(m, 4);
+    let clip: Vec<f64> = reference[at..at + m]
+        .iter()
+        .zip(&noise)
+        .map(|(r, n)| r + 0.2 * (n - 50.0))
+        .collect();
+    for score in [Score::Combined, Score::Cc] {
+        let opts = MatchOptions {
+            top: 6,
+            score,
+            verify: Some(100_000),
+            ..MatchOptions::default()
+        };
+        let counted = Counted {
+            values: &reference,
+            longest: 0.into(),
+        };
+        let res = match_trace(&clip, &counted, &opts).unwrap();
+        // never more than a block of the reference at once
+        let longest = counted.longest.into_inner();
+        assert!(longest <= 1 << 16, "{longest}");
+        // every offset's key in memory, then the same picks, null and rank from them
+        let filled = fill_gaps(&clip);
+        let mean = filled.iter().sum::<f64>() / m as f64;
+        let q: Vec<f64> = filled.iter().map(|v| v - mean).collect();
+        let r_mean = reference[..].finite_mean().unwrap();
+        let keys = scores_all(&q, mean - r_mean, &reference[..], r_mean, 480, score).unwrap();
+        let picks = best_offsets(&keys, opts.top, opts.exclusion);
+        let got: Vec<usize> = res
+            .candidates
+            .iter()
+            .map(|c| c.offset.round() as usize)
+            .collect();
+        assert_eq!(got, picks, "{score:?}");
+        assert_eq!(picks[0], at);
+        let stat = |k: f32| key_to_statistic(score, k as f64);
+        let bl = res.block_len;
+        let maxima: Vec<f64> = keys
+            .chunks(bl)
+            .enumerate()
+            .filter(|(i, _)| (i + 1) * bl + m <= at || i * bl > at + m)
+            .filter_map(|(_, c)| {
+                c.iter()
+                    .copied()
+                    .filter(|v| v.is_finite())
+                    .max_by(f32::total_cmp)
+            })
+            .map(stat)
+            .collect();
+        assert_eq!(res.null_blocks, maxima.len());
+        let tail = TailFit::new(maxima);
+        for c in &res.candidates {
+            let k = c.offset.round() as usize;
+            assert_eq!(c.p_value, tail.p_value(stat(keys[k])), "{score:?} at {k}");
+        }
+        let v = res.verification.unwrap();
+        let key = keys[100_000];
+        let better = (0..keys.len())
+            .filter(|&i| keys[i] > key && i.abs_diff(100_000) >= opts.exclusion)
+            .count();
+        assert_eq!((v.rank, v.p_value), (better + 1, tail.p_value(stat(key))));
+        assert_eq!(res.offsets, keys.iter().filter(|v| v.is_finite()).count());
+    }
 }

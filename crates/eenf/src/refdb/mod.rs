@@ -1,16 +1,26 @@
 //! The reference store: one time-indexed ENF series per grid, kept as 32-bit integers
 //! (µHz deviation from the nominal frequency; a year at 1 s is 126 MB), gaps kept as gaps.
 //!
-//! Layout: `DIR/<grid>.json`, the grid's manifest (metadata, the name of its values file and
-//! the values' CRC-32), and the values file it names, `DIR/<grid>.<generation>.i32`
-//! (little-endian values, one per step from `start_unix_s`; `i32::MIN` marks a gap). Stores
-//! written before generations (no `values_file`) keep their values in `DIR/<grid>.i32`.
+//! Layout: `DIR/<grid>.json`, the grid's manifest (metadata and its parts), and the parts it
+//! names, `DIR/<grid>.<generation>.i32`: little-endian values, one per step, each part holding
+//! the values of one stretch of [`PART_VALUES`] steps counted from the Unix epoch (48.5 days at
+//! 1 s), with its first index and CRC-32 in the manifest. Stretches without a part are gaps;
+//! `i32::MIN` marks a gap inside one. Adding a month to a decade rewrites the two or three
+//! parts it touches, not the decade. Stores written before parts name one values file
+//! (`values_file`, or `DIR/<grid>.i32` before generations): it is read as one part, and split
+//! into parts at its first change.
 //!
-//! A change commits in one atomic step: the new values go to a new file, then the manifest is
-//! renamed over the old one, then the old values file is removed. A kill at any moment leaves
-//! the old store or the new one. Builds hold an exclusive lock on `DIR/.eenf-store.lock` for
-//! their whole read-merge-write, so that two builds into one store follow each other; readers
-//! take it shared.
+//! A change commits in one atomic step: changed parts go to new files, then the manifest is
+//! renamed over the old one, then the files it no longer names are removed. A kill at any
+//! moment leaves the old store or the new one. Builds hold an exclusive lock on
+//! `DIR/.eenf-store.lock` for their whole read-merge-write, so that two builds into one store
+//! follow each other; readers take it shared.
+
+mod edit;
+mod values;
+
+pub use edit::GridEdit;
+pub use values::{GridSummary, GridValues};
 
 use eenf_core::spelling::switch;
 use std::fs::File;
@@ -19,8 +29,6 @@ use std::path::{Path, PathBuf};
 use eenf_core::Grid;
 
 use crate::error::{fail, Context, Result};
-
-use crate::output::write_atomic;
 
 /// The value that marks a missing second.
 pub const GAP: i32 = i32::MIN;
@@ -50,10 +58,101 @@ pub struct RefMeta {
     /// CRC-32 (IEEE) of the values file's bytes; absent in older stores.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub values_crc32: Option<u32>,
+    /// The files holding the values, in order; absent in stores with one values file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parts: Option<Vec<Part>>,
 }
 
-/// One grid of a store, read into memory: its metadata and values (what `match` loads its
-/// reference series from).
+/// One file of a grid's values: `count` values from index `first` of the series.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Part {
+    /// Its file name in the store.
+    pub file: String,
+    /// Index of its first value in the series.
+    pub first: usize,
+    /// Values it holds.
+    pub count: usize,
+    /// CRC-32 (IEEE) of its bytes; absent in stores written before checksums.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crc32: Option<u32>,
+}
+
+/// Values per part: 2^22, 48.5 days at 1 s (16 MB).
+pub const PART_VALUES: usize = 1 << 22;
+
+impl RefMeta {
+    /// The parts that hold the values: those the manifest lists, or the one values file of an
+    /// older store.
+    pub fn parts_listed(&self) -> Vec<Part> {
+        match &self.parts {
+            Some(p) => p.clone(),
+            None => vec![Part {
+                file: self
+                    .values_file
+                    .clone()
+                    .unwrap_or_else(|| format!("{}.i32", self.grid)),
+                first: 0,
+                count: self.count,
+                crc32: self.values_crc32,
+            }],
+        }
+    }
+
+    /// Index 0's place on the steps counted from the Unix epoch (parts' stretches are counted
+    /// there, so that moving the start earlier moves no boundary).
+    fn origin(&self) -> i64 {
+        (self.start_unix_s / self.step_s).round() as i64
+    }
+
+    /// Places `n` values that start at `start_unix_s` on this series: the index of the first,
+    /// and how many gaps were put before the old first value (the start moved earlier). The
+    /// series' count grows to hold them.
+    fn place(&mut self, start_unix_s: f64, n: usize, empty: bool) -> Result<(usize, usize)> {
+        let step = self.step_s;
+        if empty {
+            self.start_unix_s = start_unix_s;
+            self.count = 0;
+        }
+        let mut first = ((start_unix_s - self.start_unix_s) / step).round() as i64;
+        let mut pad = 0;
+        if first < 0 {
+            pad = (-first) as usize;
+            if pad + self.count > MAX_VALUES {
+                fail!(Store, "the series would span more than ten years");
+            }
+            self.start_unix_s -= pad as f64 * step;
+            self.count += pad;
+            first = 0;
+        }
+        let end = first as usize + n;
+        if end > MAX_VALUES {
+            fail!(Store, "the series would span more than ten years");
+        }
+        self.count = self.count.max(end);
+        Ok((first as usize, pad))
+    }
+}
+
+/// A frequency as stored: µHz from `nominal_hz`, `None` for a gap.
+fn to_stored(hz: f64, nominal_hz: f64) -> Option<i32> {
+    hz.is_finite().then(|| {
+        ((hz - nominal_hz) * 1e6)
+            .round()
+            .clamp(-(i32::MAX as f64), i32::MAX as f64) as i32
+    })
+}
+
+/// A stored value in Hz, NaN for a gap.
+fn to_hz(v: i32, nominal_hz: f64) -> f64 {
+    if v == GAP {
+        f64::NAN
+    } else {
+        nominal_hz + v as f64 * 1e-6
+    }
+}
+
+/// One grid's series held in memory: its metadata and values (what a folder of hourly WAVs
+/// becomes for `match`, and a whole grid read by [`StoredGrid::load`]).
 #[derive(Debug, Clone)]
 pub struct StoredGrid {
     /// Metadata.
@@ -138,6 +237,20 @@ fn manifest(dir: &Path, grid: &str) -> PathBuf {
     dir.join(format!("{grid}.json"))
 }
 
+/// The file of `part` in the store at `dir`, refused when the manifest names anything but a
+/// plain file of the store (a manifest must not make eenf read or write elsewhere).
+fn part_path(dir: &Path, grid: &str, part: &Part) -> Result<PathBuf> {
+    let name = &part.file;
+    if name.is_empty() || name.contains(['/', '\\']) || name.starts_with('.') {
+        fail!(
+            Store,
+            "{}: names {name:?} as its values, not a file of the store",
+            manifest(dir, grid).display()
+        );
+    }
+    Ok(dir.join(name))
+}
+
 /// The CRC-32 of values as the store writes them.
 fn crc_of(bytes: &[u8]) -> u32 {
     let mut h = crc32fast::Hasher::new();
@@ -159,6 +272,7 @@ impl StoredGrid {
                     .into(),
                 values_file: None,
                 values_crc32: None,
+                parts: None,
             },
             values: Vec::new(),
         }
@@ -224,109 +338,23 @@ impl StoredGrid {
         Ok(meta)
     }
 
-    /// The values file a manifest names (a plain file name in the store).
-    fn values_path(dir: &Path, meta: &RefMeta) -> Result<PathBuf> {
-        let name = meta
-            .values_file
-            .clone()
-            .unwrap_or_else(|| format!("{}.i32", meta.grid));
-        if name.contains(['/', '\\']) || name.starts_with('.') {
-            fail!(
-                Store,
-                "{}: names {name:?} as its values, not a file of the store",
-                manifest(dir, &meta.grid).display()
-            );
-        }
-        Ok(dir.join(name))
-    }
-
-    /// Loads one grid, checking the values against the manifest's count and checksum.
+    /// Loads one grid whole, checking its parts against the manifest and their checksums.
     pub fn load(dir: &Path, grid: &str) -> Result<Self> {
-        let meta = Self::load_meta(dir, grid)?;
-        let data = Self::values_path(dir, &meta)?;
-        let len = std::fs::metadata(&data)
-            .with_context(|| format!("{}", data.display()))?
-            .len();
-        if len != meta.count as u64 * 4 || meta.count > MAX_VALUES {
-            fail!(
-                Store,
-                "{}: {len} bytes where the manifest announces {} values: the store was damaged \
-                 (a build interrupted before eenf committed its changes atomically); build this \
-                 grid again from its sources",
-                data.display(),
-                meta.count
-            );
-        }
-        let bytes = std::fs::read(&data).with_context(|| format!("{}", data.display()))?;
-        if let Some(want) = meta.values_crc32 {
-            let got = crc_of(&bytes);
-            if got != want {
-                fail!(
-                    Store,
-                    "{}: the values do not match their checksum (CRC-32 {got:08x}, the manifest \
-                     says {want:08x}): they were damaged on disk; build this grid again from its \
-                     sources",
-                    data.display()
-                );
-            }
-        }
-        let values = bytes
-            .chunks_exact(4)
-            .map(|c| i32::from_le_bytes(c.try_into().unwrap()))
-            .collect();
-        Ok(StoredGrid { meta, values })
-    }
-
-    /// Commits the series: a new values file, then the manifest that names it renamed over
-    /// the old one (the commit), then the old values file removed. Call it under
-    /// [`StoreLock::exclusive`].
-    pub fn save(&mut self, dir: &Path) -> Result<()> {
-        check_grid_name(&self.meta.grid)?;
-        std::fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
-        let json = manifest(dir, &self.meta.grid);
-        let old = Self::load_meta(dir, &self.meta.grid)
-            .ok()
-            .and_then(|m| Self::values_path(dir, &m).ok());
-        let mut bytes = Vec::with_capacity(self.values.len() * 4);
-        for v in &self.values {
-            bytes.extend_from_slice(&v.to_le_bytes());
-        }
-        // a new name for every commit: the old file stays whole until the manifest moves on
-        let stamp = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.as_nanos())
-            .unwrap_or(0);
-        let name = format!("{}.{stamp:x}.{}.i32", self.meta.grid, std::process::id());
-        let data = dir.join(&name);
-        write_atomic(&data, |w| {
-            w.write_all(&bytes)?;
-            Ok(())
-        })?;
-        File::open(&data)
-            .and_then(|f| f.sync_all())
-            .with_context(|| format!("{}", data.display()))?;
-        self.meta.count = self.values.len();
-        self.meta.values_file = Some(name);
-        self.meta.values_crc32 = Some(crc_of(&bytes));
-        write_atomic(&json, |w| {
-            serde_json::to_writer_pretty(&mut *w, &self.meta)?;
-            Ok(())
-        })?;
-        if let Ok(d) = File::open(dir) {
-            let _ = d.sync_all();
-        }
-        if let Some(old) = old.filter(|o| *o != data) {
-            let _ = std::fs::remove_file(old);
-        }
-        Ok(())
+        let g = GridValues::open(dir, grid)?;
+        g.check()?;
+        let values = g.read_all()?;
+        Ok(StoredGrid {
+            meta: g.meta,
+            values,
+        })
     }
 
     /// Removes values files of `grid` that its manifest does not name (left by builds killed
     /// before their commit). Call it under [`StoreLock::exclusive`].
     pub fn remove_orphans(dir: &Path, grid: &str) -> Result<usize> {
-        let named = Self::load_meta(dir, grid)
-            .ok()
-            .and_then(|m| Self::values_path(dir, &m).ok());
+        let named: Vec<String> = Self::load_meta(dir, grid)
+            .map(|m| m.parts_listed().into_iter().map(|p| p.file).collect())
+            .unwrap_or_default();
         let prefix = format!("{grid}.");
         let mut removed = 0;
         for e in std::fs::read_dir(dir).with_context(|| format!("{}", dir.display()))? {
@@ -336,7 +364,7 @@ impl StoredGrid {
                 .strip_prefix(&prefix)
                 .and_then(|r| r.strip_suffix(".i32"))
                 .is_some_and(|g| g.contains('.'));
-            if generation && Some(&p) != named.as_ref() && std::fs::remove_file(&p).is_ok() {
+            if generation && !named.iter().any(|n| *n == file) && std::fs::remove_file(&p).is_ok() {
                 removed += 1;
             }
         }
@@ -346,54 +374,25 @@ impl StoredGrid {
     /// Values in Hz, NaN for gaps.
     pub fn hz(&self) -> Vec<f64> {
         let f0 = self.meta.nominal_hz;
-        self.values
-            .iter()
-            .map(|&v| {
-                if v == GAP {
-                    f64::NAN
-                } else {
-                    f0 + v as f64 * 1e-6
-                }
-            })
-            .collect()
+        self.values.iter().map(|&v| to_hz(v, f0)).collect()
     }
 
     /// Places `hz` (one value per `step_s` from `start_unix_s`) into the series, resampled to
     /// the series' step; the series grows (with gaps) as needed, and new values replace old.
     pub fn merge(&mut self, start_unix_s: f64, step_s: f64, hz: &[f64]) -> Result<()> {
         let vals = eenf_dsp::resample::resample(hz, step_s, self.meta.step_s);
-        let step = self.meta.step_s;
-        if self.values.is_empty() {
-            self.meta.start_unix_s = start_unix_s;
+        let empty = self.values.is_empty();
+        let (first, pad) = self.meta.place(start_unix_s, vals.len(), empty)?;
+        if pad > 0 {
+            self.values.splice(0..0, std::iter::repeat_n(GAP, pad));
         }
-        let mut first = ((start_unix_s - self.meta.start_unix_s) / step).round() as i64;
-        if first < 0 {
-            let pad = (-first) as usize;
-            if pad + self.values.len() > MAX_VALUES {
-                fail!(Store, "the series would span more than ten years");
-            }
-            let mut v = vec![GAP; pad];
-            v.extend_from_slice(&self.values);
-            self.values = v;
-            self.meta.start_unix_s -= pad as f64 * step;
-            first = 0;
-        }
-        let end = first as usize + vals.len();
-        if end > MAX_VALUES {
-            fail!(Store, "the series would span more than ten years");
-        }
-        if self.values.len() < end {
-            self.values.resize(end, GAP);
-        }
+        self.values.resize(self.meta.count, GAP);
         let f0 = self.meta.nominal_hz;
-        for (slot, v) in self.values[first as usize..end].iter_mut().zip(&vals) {
-            if v.is_finite() {
-                *slot = ((v - f0) * 1e6)
-                    .round()
-                    .clamp(-(i32::MAX as f64), i32::MAX as f64) as i32;
+        for (slot, v) in self.values[first..].iter_mut().zip(&vals) {
+            if let Some(x) = to_stored(*v, f0) {
+                *slot = x;
             }
         }
-        self.meta.count = self.values.len();
         Ok(())
     }
 }
