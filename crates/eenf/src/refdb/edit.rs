@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use eenf_core::Grid;
 
-use super::values::GridValues;
+use super::values::{decode, read_bytes, read_part, GridValues};
 use super::{crc_of, manifest, part_path, to_stored, Part, RefMeta, StoredGrid, GAP, PART_VALUES};
 use crate::error::{fail, Context, Result};
 use crate::output::write_atomic;
@@ -149,7 +149,7 @@ impl GridEdit {
             let path = part_path(&self.dir, &self.meta.grid, part)?;
             let mut bytes = vec![0u8; (b - a) * 4];
             let file = File::open(&path).with_context(|| format!("{}", path.display()))?;
-            read_at(&file, a - part.first, &mut bytes)
+            read_bytes(&file, a - part.first, &mut bytes)
                 .with_context(|| format!("{}", path.display()))?;
             if let (true, Some(want)) = (whole, part.crc32) {
                 if crc_of(&bytes) != want {
@@ -161,10 +161,7 @@ impl GridEdit {
                     );
                 }
             }
-            let dst = &mut values[at + (a - lo)..at + (b - lo)];
-            for (d, ch) in dst.iter_mut().zip(bytes.chunks_exact(4)) {
-                *d = i32::from_le_bytes([ch[0], ch[1], ch[2], ch[3]]);
-            }
+            decode(&bytes, &mut values[at + (a - lo)..at + (b - lo)]);
         }
         self.open.push((c, values));
         Ok(&mut self.open.last_mut().expect("just pushed").1)
@@ -194,13 +191,9 @@ impl GridEdit {
                 let (s, off) = self.stretch_of(i);
                 let n = (PART_VALUES - off).min(end - i);
                 if s != c {
-                    let mut bytes = vec![0u8; n * 4];
-                    read_at(&file, i - old.first, &mut bytes)
+                    let mut vals = vec![GAP; n];
+                    read_part(&file, i - old.first, &mut vals)
                         .with_context(|| format!("{}", path.display()))?;
-                    let vals: Vec<i32> = bytes
-                        .chunks_exact(4)
-                        .map(|ch| i32::from_le_bytes([ch[0], ch[1], ch[2], ch[3]]))
-                        .collect();
                     self.add_part(i, &vals)?;
                 }
                 i += n;
@@ -300,9 +293,4 @@ impl Drop for GridEdit {
             let _ = std::fs::remove_file(path);
         }
     }
-}
-
-/// Reads a file's bytes from value `at` into `bytes`.
-fn read_at(file: &File, at: usize, bytes: &mut [u8]) -> std::io::Result<()> {
-    super::values::read_bytes(file, at, bytes)
 }

@@ -67,14 +67,14 @@ pub(super) fn read_bytes(file: &File, at: usize, bytes: &mut [u8]) -> std::io::R
 }
 
 /// Little-endian values from their bytes.
-fn decode(bytes: &[u8], dst: &mut [i32]) {
+pub(super) fn decode(bytes: &[u8], dst: &mut [i32]) {
     for (d, c) in dst.iter_mut().zip(bytes.chunks_exact(4)) {
         *d = i32::from_le_bytes([c[0], c[1], c[2], c[3]]);
     }
 }
 
 /// Reads `dst.len()` values of a part's file from value `at`.
-fn read_part(file: &File, at: usize, dst: &mut [i32]) -> std::io::Result<()> {
+pub(super) fn read_part(file: &File, at: usize, dst: &mut [i32]) -> std::io::Result<()> {
     let mut bytes = vec![0u8; dst.len() * 4];
     read_bytes(file, at, &mut bytes)?;
     decode(&bytes, dst);
