@@ -433,12 +433,13 @@ pub fn match_trace<R: ReferenceValues + ?Sized>(
                     let j = k0 / block_len;
                     let n = ((j + 1) * block_len - k0).min(keys.len() - i);
                     let part = &keys[i..i + n];
-                    // the maximum in a loop without branches (a key without a score is NaN,
-                    // which no comparison passes); where it beats the block's best so far,
-                    // its first place
-                    let top = part
-                        .iter()
-                        .fold(f32::NEG_INFINITY, |a, &v| if v > a { v } else { a });
+                    // the maximum and the keys with a score in a loop without branches (a key
+                    // without a score is NaN, which no comparison passes); where it beats the
+                    // block's best so far, its first place
+                    let (top, finite) =
+                        part.iter().fold((f32::NEG_INFINITY, 0usize), |(a, n), &v| {
+                            (if v > a { v } else { a }, n + usize::from(v.is_finite()))
+                        });
                     let top = if top == f32::NEG_INFINITY {
                         f32::NAN
                     } else {
@@ -449,7 +450,7 @@ pub fn match_trace<R: ReferenceValues + ?Sized>(
                         s.best = Some((k0 + at, top));
                     }
                     s.null_max[j - s.null_first] = top;
-                    s.scored += part.iter().filter(|v| v.is_finite()).count();
+                    s.scored += finite;
                     if let (Some(key), Some(at)) = (verify_key, opts.verify) {
                         s.better += (k0..)
                             .zip(part)

@@ -22,9 +22,7 @@ pub(crate) struct Scorer<'a, R: ?Sized> {
     fwd: Arc<dyn RealToComplex<f64>>,
     inv: Arc<dyn ComplexToReal<f64>>,
     qspec: Vec<Complex64>,
-    q_norm: f64,
-    q_mean: f64,
-    q_abs_sq: f64,
+    formula: KeyFormula,
     q_raw: Vec<f64>,
     r_mean: f64,
     min_valid: usize,
@@ -75,10 +73,13 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
             fwd,
             inv,
             qspec,
-            q_norm: q.iter().map(|v| v * v).sum::<f64>().sqrt(),
-            q_mean,
-            // Σ (q + q_mean)² for the RMSE
-            q_abs_sq: q.iter().map(|v| (v + q_mean) * (v + q_mean)).sum::<f64>(),
+            formula: KeyFormula {
+                q_norm: q.iter().map(|v| v * v).sum::<f64>().sqrt(),
+                // Σ (q + q_mean)² for the RMSE
+                q_abs_sq: q.iter().map(|v| (v + q_mean) * (v + q_mean)).sum::<f64>(),
+                q_mean,
+                inv_m: 1.0 / m as f64,
+            },
             // the trace in the reference's own units, for windows with gaps
             q_raw: q.iter().map(|v| v + q_mean + r_mean).collect(),
             r_mean,
@@ -122,12 +123,13 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
         let have = (start + self.block).min(r.len()) - start;
         r.read(start, &mut b.raw[..have])?;
         b.raw[have..].fill(f64::NAN);
-        for (d, &v) in b.seg.iter_mut().zip(&b.raw) {
-            *d = v - self.r_mean;
-        }
         // gaps count as zero in the FFT; their windows are redone below
-        for (d, &v) in b.buf.iter_mut().zip(&b.seg) {
-            *d = if v.is_finite() { v } else { 0.0 };
+        let mut finite = true;
+        for ((d, z), &v) in b.seg.iter_mut().zip(b.buf.iter_mut()).zip(&b.raw) {
+            let x = v - self.r_mean;
+            *d = x;
+            *z = if x.is_finite() { x } else { 0.0 };
+            finite &= x.is_finite();
         }
         self.fwd
             .process_with_scratch(&mut b.buf, &mut b.spec, &mut b.s1)
@@ -139,52 +141,49 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
             .process_with_scratch(&mut b.spec, &mut b.buf, &mut b.s2)
             .expect("sized by plan");
         let count = dst.len();
-        let inv_m = 1.0 / m as f64;
-        if b.seg[..count + m - 1].iter().all(|v| v.is_finite()) {
+        let formula = &self.formula;
+        if finite || b.seg[..count + m - 1].iter().all(|v| v.is_finite()) {
             // no gap under any window: the running sums first, then every key from them in a
-            // loop without branches (the formulas of the loop below)
-            let (sums, sq_sums) = (&mut b.s, &mut b.ss);
+            // loop without branches (the formula of the loop below)
             let seg = &b.seg;
-            // two halves slid side by side: two chains of additions in flight, not one
-            let half = count.div_ceil(2);
-            let start_sums = |k: usize| {
-                let (mut s, mut ss) = (0.0f64, 0.0f64);
-                for &v in &seg[k..k + m] {
-                    s += v;
-                    ss += v * v;
-                }
-                (s, ss)
-            };
-            let ((mut s0, mut ss0), (mut s1, mut ss1)) = (start_sums(0), start_sums(half));
-            sums[0] = s0;
-            sq_sums[0] = ss0;
-            sums[half] = s1;
-            sq_sums[half] = ss1;
-            for k in 1..half {
-                let (old, new) = (seg[k - 1], seg[k + m - 1]);
-                s0 = s0 - old + new;
-                ss0 = ss0 - old * old + new * new;
-                sums[k] = s0;
-                sq_sums[k] = ss0;
-                let j = k + half;
-                if j < count {
-                    let (old, new) = (seg[j - 1], seg[j + m - 1]);
-                    s1 = s1 - old + new;
-                    ss1 = ss1 - old * old + new * new;
-                    sums[j] = s1;
-                    sq_sums[j] = ss1;
+            let (sums, sq_sums) = (&mut b.s[..count], &mut b.ss[..count]);
+            // the running sums in four stretches slid side by side (four chains of additions
+            // in flight, not one); each window adds what enters it less what leaves it
+            const LANES: usize = 4;
+            let len = count.div_ceil(LANES);
+            let mut acc = [(0.0f64, 0.0f64); LANES];
+            for (l, a) in acc.iter_mut().enumerate() {
+                let k = l * len;
+                if k < count {
+                    for &v in &seg[k..k + m] {
+                        a.0 += v;
+                        a.1 += v * v;
+                    }
+                    (sums[k], sq_sums[k]) = *a;
                 }
             }
-            let sums = WindowSums {
-                xc: &b.buf[..count],
-                s: &sums[..count],
-                ss: &sq_sums[..count],
-                q_norm: self.q_norm,
-                q_abs_sq: self.q_abs_sq,
-                q_mean: self.q_mean,
-                inv_m,
+            let step = |a: &mut (f64, f64), j: usize, sums: &mut [f64], sq_sums: &mut [f64]| {
+                let (old, new) = (seg[j - 1], seg[j + m - 1]);
+                a.0 += new - old;
+                a.1 += new * new - old * old;
+                (sums[j], sq_sums[j]) = *a;
             };
-            sums.keys(self.score, dst);
+            // lanes are `len` long but the last ones, which may be shorter: up to the last
+            // lane's length, every lane steps
+            let full = count.saturating_sub((LANES - 1) * len);
+            for k in 1..full {
+                for (l, a) in acc.iter_mut().enumerate() {
+                    step(a, l * len + k, sums, sq_sums);
+                }
+            }
+            for k in full.max(1)..len {
+                for (l, a) in acc.iter_mut().enumerate() {
+                    if l * len + k < count {
+                        step(a, l * len + k, sums, sq_sums);
+                    }
+                }
+            }
+            formula.keys(self.score, &b.buf[..count], sums, sq_sums, dst);
             return Ok(());
         }
         let (seg, xc) = (&b.seg, &b.buf);
@@ -214,21 +213,16 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
                     gaps += 1;
                 }
             }
-            let (cc, e) = if gaps == 0 {
-                let var = ss - s * s * inv_m;
-                let cc = xc[k] / (self.q_norm * var.sqrt());
-                // Σ(q − r)² = Σq² − 2Σq·r + Σr², with Σq·r = Σ(q − q̄)·r + q̄·Σr
-                let sse = self.q_abs_sq - 2.0 * (xc[k] + self.q_mean * s) + ss;
-                (cc, (sse.max(0.0) * inv_m).sqrt())
+            *o = if gaps == 0 {
+                formula.key(self.score, xc[k], s, ss)
             } else if m - gaps >= self.min_valid {
                 let a = score_at(&self.q_raw, &b.raw[k..k + m]);
-                (a.cc, a.rmse_hz)
-            } else {
-                (f64::NAN, f64::NAN)
-            };
-            // a flat window (var = 0) gives a non-finite CC and no score
-            *o = if cc.is_finite() && e.is_finite() {
-                rank_key(self.score, cc, e) as f32
+                // a flat window (var = 0) gives a non-finite CC and no score
+                if a.cc.is_finite() && a.rmse_hz.is_finite() {
+                    rank_key(self.score, a.cc, a.rmse_hz) as f32
+                } else {
+                    f32::NAN
+                }
             } else {
                 f32::NAN
             };
@@ -237,52 +231,60 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
     }
 }
 
-/// A block's cross-correlations and running window sums, from which its keys follow.
-struct WindowSums<'a> {
-    xc: &'a [f64],
-    s: &'a [f64],
-    ss: &'a [f64],
+/// The key of a window without gaps from its cross-correlation `x` with the trace and its
+/// sums `s` = Σr, `ss` = Σr²: [`rank_key`]'s value, in one square root and one division.
+struct KeyFormula {
     q_norm: f64,
     q_abs_sq: f64,
     q_mean: f64,
     inv_m: f64,
 }
 
-impl WindowSums<'_> {
-    /// The keys into `dst`: the operations of [`rank_key`] in a loop without branches, which
-    /// the compiler vectorises (two offsets at a time in SSE2; each operation correctly
-    /// rounded, so the same numbers as one at a time).
-    fn keys(&self, score: Score, dst: &mut [f32]) {
+impl KeyFormula {
+    /// The key for `score`.
+    fn key(&self, score: Score, x: f64, s: f64, ss: f64) -> f32 {
         match score {
-            Score::Combined => self.keys_of::<true>(dst),
-            Score::Cc => self.keys_of::<false>(dst),
+            Score::Combined => self.key_of::<true>(x, s, ss),
+            Score::Cc => self.key_of::<false>(x, s, ss),
         }
     }
 
     #[inline(always)]
-    fn keys_of<const COMBINED: bool>(&self, dst: &mut [f32]) {
-        let (q_norm, q_abs_sq, q_mean, inv_m) =
-            (self.q_norm, self.q_abs_sq, self.q_mean, self.inv_m);
-        for (((o, &x), &s), &ss) in dst.iter_mut().zip(self.xc).zip(self.s).zip(self.ss) {
-            let var = ss - s * s * inv_m;
-            let cc = x / (q_norm * var.sqrt());
-            // Σ(q − r)² = Σq² − 2Σq·r + Σr², with Σq·r = Σ(q − q̄)·r + q̄·Σr
-            let sse = q_abs_sq - 2.0 * (x + q_mean * s) + ss;
-            let e = (sse.max(0.0) * inv_m).sqrt();
-            // as rank_key
-            let c = cc.clamp(-0.999_999, 0.999_999);
-            let key = if COMBINED {
-                let e = e.max(1e-6);
-                (1.0 + c) / ((1.0 - c) * e * e)
-            } else {
-                c
-            };
-            // a flat window (var = 0) gives a non-finite CC and no score
-            *o = if cc.is_finite() && e.is_finite() {
-                key as f32
-            } else {
-                f32::NAN
-            };
+    fn key_of<const COMBINED: bool>(&self, x: f64, s: f64, ss: f64) -> f32 {
+        // CC = x / d, d = |q|·|r − r̄|; clamped to ±0.999999 as rank_key does, by clamping x
+        let d = self.q_norm * (ss - s * s * self.inv_m).sqrt();
+        // (max and min, not clamp: d may be NaN, and then there is no score)
+        let x_c = x.max(-0.999_999 * d).min(0.999_999 * d);
+        let key = if COMBINED {
+            // Σ(q − r)² = Σq² − 2Σq·r + Σr², with Σq·r = Σ(q − q̄)·r + q̄·Σr; RMSE ≥ 1e-6
+            let sse = self.q_abs_sq - 2.0 * (x + self.q_mean * s) + ss;
+            let e2 = (sse * self.inv_m).max(1e-12);
+            // (1 + CC) / ((1 − CC)·RMSE²)
+            (d + x_c) / ((d - x_c) * e2)
+        } else {
+            x_c / d
+        };
+        // a flat window (d = 0) or a NaN has no score
+        if d > 0.0 && key.is_finite() {
+            key as f32
+        } else {
+            f32::NAN
+        }
+    }
+
+    /// The keys of a block without gaps into `dst`, in a loop without branches that the
+    /// compiler vectorises (each operation correctly rounded: the numbers of [`Self::key`]).
+    fn keys(&self, score: Score, xc: &[f64], s: &[f64], ss: &[f64], dst: &mut [f32]) {
+        match score {
+            Score::Combined => self.keys_of::<true>(xc, s, ss, dst),
+            Score::Cc => self.keys_of::<false>(xc, s, ss, dst),
+        }
+    }
+
+    #[inline(always)]
+    fn keys_of<const COMBINED: bool>(&self, xc: &[f64], s: &[f64], ss: &[f64], dst: &mut [f32]) {
+        for (((o, &x), &s), &ss) in dst.iter_mut().zip(xc).zip(s).zip(ss) {
+            *o = self.key_of::<COMBINED>(x, s, ss);
         }
     }
 }

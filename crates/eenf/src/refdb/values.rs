@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use eenf_dsp::matching::{MatchError, ReferenceValues};
 
-use super::{manifest, part_path, to_hz, Part, RefMeta, StoredGrid, GAP, MAX_VALUES};
+use super::{manifest, part_path, Part, RefMeta, StoredGrid, GAP, MAX_VALUES};
 use crate::error::{fail, Context, Result};
 
 /// Values read per request while checking and summing up a part.
@@ -144,33 +144,34 @@ impl GridValues {
             .map(|(part, path, file)| -> Result<PartSums> {
                 let mut h = crc32fast::Hasher::new();
                 let mut s = PartSums::default();
-                let (mut buf, mut bytes) = (vec![0i32; STRETCH], vec![0u8; STRETCH * 4]);
+                let mut bytes = vec![0u8; STRETCH * 4];
                 let mut prev_gap = false;
                 for lo in (0..part.count).step_by(STRETCH) {
-                    let chunk = &mut buf[..STRETCH.min(part.count - lo)];
-                    let raw = &mut bytes[..chunk.len() * 4];
+                    let raw = &mut bytes[..STRETCH.min(part.count - lo) * 4];
                     read_bytes(file, lo, raw).with_context(|| format!("{}", path.display()))?;
                     h.update(raw);
-                    decode(raw, chunk);
-                    if !chunk.contains(&GAP) {
-                        // the common case, in a loop the compiler vectorises
-                        s.finite += chunk.len();
-                        s.sum += chunk.iter().map(|&v| v as i64).sum::<i64>() as i128;
+                    // gaps and the sum of the rest in one loop the compiler vectorises
+                    let (mut gaps, mut sum) = (0usize, 0i64);
+                    for c in raw.chunks_exact(4) {
+                        let v = i32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+                        let gap = v == GAP;
+                        gaps += usize::from(gap);
+                        sum += if gap { 0 } else { v as i64 };
+                    }
+                    let n = raw.len() / 4;
+                    s.finite += n - gaps;
+                    s.sum += sum as i128;
+                    if gaps == 0 {
                         if lo == 0 {
                             s.starts_gap = false;
                         }
                         prev_gap = false;
                         continue;
                     }
-                    for (i, &v) in chunk.iter().enumerate() {
-                        let gap = v == GAP;
-                        if gap {
-                            if !prev_gap && (lo + i) > 0 {
-                                s.gap_runs += 1;
-                            }
-                        } else {
-                            s.finite += 1;
-                            s.sum += v as i128;
+                    for (i, c) in raw.chunks_exact(4).enumerate() {
+                        let gap = i32::from_le_bytes([c[0], c[1], c[2], c[3]]) == GAP;
+                        if gap && !prev_gap && (lo + i) > 0 {
+                            s.gap_runs += 1;
                         }
                         if lo + i == 0 {
                             s.starts_gap = gap;
@@ -255,6 +256,42 @@ impl GridValues {
         Ok(())
     }
 
+    /// Values `start .. start + dst.len()` (within the series) in Hz, NaN where no part holds
+    /// them: from the file's bytes straight to Hz, through one buffer per thread (this is
+    /// what a search reads, a block at a time).
+    pub fn read_hz(&self, start: usize, dst: &mut [f64]) -> Result<()> {
+        thread_local! {
+            static BUFFERS: std::cell::RefCell<(Vec<u8>, Vec<i32>)> =
+                const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
+        }
+        dst.fill(f64::NAN);
+        let end = start + dst.len();
+        let from = self
+            .parts
+            .partition_point(|(p, _, _)| p.first + p.count <= start);
+        let f0 = self.meta.nominal_hz;
+        BUFFERS.with_borrow_mut(|(bytes, values)| {
+            for (part, path, file) in &self.parts[from..] {
+                if part.first >= end {
+                    break;
+                }
+                let lo = part.first.max(start);
+                let hi = (part.first + part.count).min(end);
+                bytes.resize((hi - lo) * 4, 0);
+                values.resize(hi - lo, 0);
+                read_bytes(file, lo - part.first, bytes)
+                    .with_context(|| format!("{}", path.display()))?;
+                decode(bytes, values);
+                // to_hz in a loop without branches, which the compiler vectorises
+                for (d, &v) in dst[lo - start..hi - start].iter_mut().zip(values.iter()) {
+                    let hz = f0 + v as f64 * 1e-6;
+                    *d = if v == GAP { f64::NAN } else { hz };
+                }
+            }
+            Ok(())
+        })
+    }
+
     /// Every value, in memory (for small grids and tests).
     pub fn read_all(&self) -> Result<Vec<i32>> {
         let mut out = vec![GAP; self.meta.count];
@@ -269,14 +306,8 @@ impl ReferenceValues for GridValues {
     }
 
     fn read(&self, start: usize, dst: &mut [f64]) -> std::result::Result<(), MatchError> {
-        let mut raw = vec![GAP; dst.len()];
-        self.read_stored(start, &mut raw)
-            .map_err(|e| MatchError::Read(e.to_string()))?;
-        let f0 = self.meta.nominal_hz;
-        for (d, &v) in dst.iter_mut().zip(&raw) {
-            *d = to_hz(v, f0);
-        }
-        Ok(())
+        self.read_hz(start, dst)
+            .map_err(|e| MatchError::Read(e.to_string()))
     }
 
     fn finite_mean(&self) -> std::result::Result<f64, MatchError> {
