@@ -391,6 +391,17 @@ pub fn match_trace<R: ReferenceValues + ?Sized>(
     // How far scores stay correlated (on the first 2^18 offsets), which sets the blocks of the
     // null: the best score in a stretch of reference unrelated to the trace follows a Gumbel law.
     let sample_len = scorer.n_off.min(1 << 18);
+    let first_blocks = (0..sample_len.div_ceil(hop))
+        .into_par_iter()
+        .map_init(
+            || scorer.buffers(),
+            |b, bi| {
+                let mut keys = Vec::new();
+                scorer.block_keys(bi, b, &mut keys).map(|()| (bi, keys))
+            },
+        )
+        .collect::<Result<Vec<_>, MatchError>>()?;
+    cache.blocks.extend(first_blocks);
     let mut sample = Vec::with_capacity(sample_len);
     for bi in 0..sample_len.div_ceil(hop) {
         sample.extend(cache.block(bi)?.iter().map(|&k| {

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use eenf_dsp::matching::{MatchError, ReferenceValues};
 
-use super::{manifest, part_path, Part, RefMeta, StoredGrid, GAP, MAX_VALUES};
+use super::{manifest, part_path, to_hz, Part, RefMeta, StoredGrid, GAP, MAX_VALUES};
 use crate::error::{fail, Context, Result};
 
 /// Values read per request while checking and summing up a part.
@@ -261,8 +261,7 @@ impl GridValues {
     /// what a search reads, a block at a time).
     pub fn read_hz(&self, start: usize, dst: &mut [f64]) -> Result<()> {
         thread_local! {
-            static BUFFERS: std::cell::RefCell<(Vec<u8>, Vec<i32>)> =
-                const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
+            static BYTES: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
         }
         dst.fill(f64::NAN);
         let end = start + dst.len();
@@ -270,7 +269,7 @@ impl GridValues {
             .parts
             .partition_point(|(p, _, _)| p.first + p.count <= start);
         let f0 = self.meta.nominal_hz;
-        BUFFERS.with_borrow_mut(|(bytes, values)| {
+        BYTES.with_borrow_mut(|bytes| {
             for (part, path, file) in &self.parts[from..] {
                 if part.first >= end {
                     break;
@@ -278,14 +277,13 @@ impl GridValues {
                 let lo = part.first.max(start);
                 let hi = (part.first + part.count).min(end);
                 bytes.resize((hi - lo) * 4, 0);
-                values.resize(hi - lo, 0);
                 read_bytes(file, lo - part.first, bytes)
                     .with_context(|| format!("{}", path.display()))?;
-                decode(bytes, values);
-                // to_hz in a loop without branches, which the compiler vectorises
-                for (d, &v) in dst[lo - start..hi - start].iter_mut().zip(values.iter()) {
-                    let hz = f0 + v as f64 * 1e-6;
-                    *d = if v == GAP { f64::NAN } else { hz };
+                for (d, c) in dst[lo - start..hi - start]
+                    .iter_mut()
+                    .zip(bytes.chunks_exact(4))
+                {
+                    *d = to_hz(i32::from_le_bytes([c[0], c[1], c[2], c[3]]), f0);
                 }
             }
             Ok(())
