@@ -257,34 +257,17 @@ impl GridValues {
     }
 
     /// Values `start .. start + dst.len()` (within the series) in Hz, NaN where no part holds
-    /// them: from the file's bytes straight to Hz, through one buffer per thread (this is
-    /// what a search reads, a block at a time).
+    /// them, through one buffer per thread (this is what a search reads, a block at a time).
     pub fn read_hz(&self, start: usize, dst: &mut [f64]) -> Result<()> {
         thread_local! {
-            static BYTES: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+            static VALUES: std::cell::RefCell<Vec<i32>> = const { std::cell::RefCell::new(Vec::new()) };
         }
-        dst.fill(f64::NAN);
-        let end = start + dst.len();
-        let from = self
-            .parts
-            .partition_point(|(p, _, _)| p.first + p.count <= start);
         let f0 = self.meta.nominal_hz;
-        BYTES.with_borrow_mut(|bytes| {
-            for (part, path, file) in &self.parts[from..] {
-                if part.first >= end {
-                    break;
-                }
-                let lo = part.first.max(start);
-                let hi = (part.first + part.count).min(end);
-                bytes.resize((hi - lo) * 4, 0);
-                read_bytes(file, lo - part.first, bytes)
-                    .with_context(|| format!("{}", path.display()))?;
-                for (d, c) in dst[lo - start..hi - start]
-                    .iter_mut()
-                    .zip(bytes.chunks_exact(4))
-                {
-                    *d = to_hz(i32::from_le_bytes([c[0], c[1], c[2], c[3]]), f0);
-                }
+        VALUES.with_borrow_mut(|values| {
+            values.resize(dst.len(), GAP);
+            self.read_stored(start, values)?;
+            for (d, &v) in dst.iter_mut().zip(values.iter()) {
+                *d = to_hz(v, f0);
             }
             Ok(())
         })
