@@ -56,6 +56,9 @@ enum Command {
     /// Evaluate methods over a dataset (EV-ENFD-like folder or manifest): the paper's Table 2,
     /// per-recording scores, reports, plots and ablations.
     Bench(commands::bench::Args),
+    /// A local web page: drop a file, see its ENF trace, when it was recorded and whether it
+    /// was edited, download a report. Prints the page's URL (with its token) first.
+    Serve(commands::serve::Args),
     /// Simulate 60 s, extract the ENF, compare it with the truth: the whole method in one go.
     Demo(commands::demo::Args),
 }
@@ -90,7 +93,9 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    if let Err(e) = terminal::clean_up_on_signals() {
+    // the server stops on signals itself, removing its uploads
+    let serving = matches!(cli.command, Command::Serve(_));
+    if let Err(e) = (!serving).then(terminal::clean_up_on_signals).transpose() {
         eprintln!("eenf: warning: {e:#}");
     }
     let progress = terminal::progress(cli.quiet);
@@ -109,6 +114,7 @@ fn main() -> ExitCode {
         Command::SimulateDataset(a) => commands::simulate_dataset::run(a, progress),
         Command::Bench(a) => commands::bench::run(a, progress),
         Command::Demo(a) => commands::demo::run(a, progress),
+        Command::Serve(a) => commands::serve::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -126,3 +126,15 @@ pub fn plot_methods(path: &Path, title: &str, series: &[Series]) -> Result<()> {
         |root| comparison(root, title, series),
     )
 }
+
+/// [`plot_comparison`]'s figure as SVG text.
+pub fn comparison_svg(title: &str, t: &[f64], est: &[f64], reference: &[f64]) -> Result<String> {
+    let series = [Series {
+        label: "estimate".into(),
+        time_s: t,
+        estimate: est,
+        reference,
+        colour: 0,
+    }];
+    render_svg(|root| comparison(root, title, &series))
+}

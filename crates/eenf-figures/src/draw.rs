@@ -81,6 +81,19 @@ pub(crate) fn render(
     }
 }
 
+/// Renders as SVG text, for a page or a report to hold inline.
+pub(crate) fn render_svg(
+    draw_svg: impl Fn(&DrawingArea<SVGBackend, Shift>) -> Result<()>,
+) -> Result<String> {
+    fonts()?;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        draw_svg(&root).and_then(|_| root.present().map_err(e))?;
+    }
+    Ok(svg)
+}
+
 /// An RGB image of `SIZE` as PNG (8 bits per channel, the encoder's default compression).
 pub(crate) fn write_png(file: std::fs::File, rgb: &[u8]) -> Result<()> {
     let mut enc = png::Encoder::new(std::io::BufWriter::new(file), SIZE.0, SIZE.1);

@@ -218,3 +218,8 @@ pub fn plot_edits(path: &Path, title: &str, report: &eenf::edits::EditReport) ->
         |a| edits_chart(a, title, report),
     )
 }
+
+/// [`plot_edits`]'s figure as SVG text.
+pub fn edits_svg(title: &str, report: &eenf::edits::EditReport) -> Result<String> {
+    render_svg(|a| edits_chart(a, title, report))
+}

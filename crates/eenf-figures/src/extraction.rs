@@ -138,3 +138,8 @@ pub fn plot_extraction(path: &Path, title: &str, trace: &Trace) -> Result<()> {
         |root| extraction(root, title, trace),
     )
 }
+
+/// [`plot_extraction`]'s figure as SVG text.
+pub fn extraction_svg(title: &str, trace: &Trace) -> Result<String> {
+    render_svg(|root| extraction(root, title, trace))
+}

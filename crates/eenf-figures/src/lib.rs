@@ -6,7 +6,7 @@
 //! ([`plot_extraction`]), spectrograms, a benchmark's summary, the flicker map of an event
 //! recording and the hum's phase with the edits found in it. The command line draws them; the
 //! Python package and a page are to draw the same ones, so they live here rather than in a front
-//! end.
+//! end. [`report`] words an analysis's verdicts and writes the report a page offers.
 
 #![forbid(unsafe_code)]
 
@@ -16,14 +16,15 @@ mod draw;
 mod edits;
 mod extraction;
 mod flicker_map;
+pub mod report;
 mod spectrogram;
 mod summary;
 
 pub use bench::write_plots;
-pub use comparison::{plot_comparison, plot_methods, Series};
+pub use comparison::{comparison_svg, plot_comparison, plot_methods, Series};
 pub use draw::title_name;
-pub use edits::plot_edits;
-pub use extraction::plot_extraction;
+pub use edits::{edits_svg, plot_edits};
+pub use extraction::{extraction_svg, plot_extraction};
 pub use flicker_map::plot_flicker_map;
 pub use spectrogram::plot_spectrogram;
 pub use summary::{plot_summary, SummaryBar};

@@ -16,6 +16,8 @@
 //!   [`dataset`] and [`dataset_build`]: simulated recordings and datasets with their truth.
 //! - [`options`]: what each front end asks for, as option sets that check themselves.
 //!
+//! [`analysis`] runs all of it on one file at once (the page's upload).
+//!
 //! [`error`] says what went wrong, by area, for each front end to word.
 //!
 //! [`recording`] is what E-ENF reads (a file or events in memory); [`trace`] reads and writes
@@ -24,6 +26,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod analysis;
 pub mod archive;
 pub mod audio;
 pub mod bench;

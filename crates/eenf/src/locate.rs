@@ -178,6 +178,7 @@ impl MatchReport {
                 let (r, c) = (&refs[p.series], &p.candidate);
                 serde_json::json!({"reference": r.name, "grid": r.grid, "start": r.time_label(c.offset),
                     "start_s": r.start + c.offset * r.step, "offset_steps": c.offset,
+                    "start_utc": r.absolute.then(|| crate::time::utc(r.start + c.offset * r.step)),
                     "cc": c.agreement.cc, "mae_hz": c.agreement.mae_hz,
                     "rmse_hz": c.agreement.rmse_hz, "overlap": c.agreement.n,
                     "p_value": c.p_value, "match": c.p_value < alpha})

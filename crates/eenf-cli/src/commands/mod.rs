@@ -22,6 +22,7 @@ pub mod info;
 pub mod matching;
 pub mod refdb;
 pub mod reference;
+pub mod serve;
 pub mod simulate;
 pub mod simulate_dataset;
 pub mod video;
