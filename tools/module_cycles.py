@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Fails when the top-level modules of a crate import each other in a circle, or when the
 library crate `eenf` depends on the command line's crates (clap, indicatif, plotters,
-signal-hook) or on `anyhow` (its errors are typed: `eenf::Error`), `eenf-figures` on `anyhow`, the Python package `eenf-py` on the command line (`eenf-cli`, clap, indicatif,
-signal-hook), or `eenf-dsp` on `eenf-events`.
+signal-hook), on `anyhow` (its errors are typed: `eenf::Error`) or on the server's (axum, tokio),
+`eenf-figures` on `anyhow` or the server's, the Python package `eenf-py` or the page `eenf-serve`
+on the command line (`eenf-cli`, clap, indicatif, signal-hook), or `eenf-dsp` on `eenf-events`.
 
 A module's imports are its `crate::NAME` paths, names re-exported by `lib.rs` resolved to the
 module that defines them. Usage: python3 tools/module_cycles.py [ROOT]"""
@@ -84,11 +85,14 @@ def main():
             bad += 1
     for package, banned in [
         # the library's errors are typed (`eenf::Error`): each front end words them
-        ("eenf", ["clap", "indicatif", "plotters", "signal-hook", "anyhow"]),
+        ("eenf", ["clap", "indicatif", "plotters", "signal-hook", "anyhow", "axum", "tokio"]),
         ("eenf-figures", ["anyhow"]),
         ("eenf-dsp", ["eenf-events"]),
         # the Python package is a front end over the library, not over the command line
-        ("eenf-py", ["clap", "indicatif", "signal-hook", "eenf-cli"]),
+        ("eenf-py", ["clap", "indicatif", "signal-hook", "eenf-cli", "eenf-serve"]),
+        # so is the page; and the library serves nothing itself
+        ("eenf-serve", ["clap", "indicatif", "signal-hook", "eenf-cli", "anyhow"]),
+        ("eenf-figures", ["axum", "tokio"]),
     ]:
         tree = subprocess.run(
             ["cargo", "tree", "-p", package, "-e", "normal", "--prefix", "none"],

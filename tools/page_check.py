@@ -8,6 +8,8 @@ starts `eenf serve --store S --port 0`, uploads the clip on the page and checks:
 - #match lists 2022-08-17T09:20:34Z (within 1 s) first;
 - the report downloaded from a#report holds the clip's SHA-256 and the trace that
   `eenf reference --json` gives for the same file;
+- a real event recording (jaer_MovingDarkBox.aedat) shows its grid and flicker map, and its
+  report's trace is the one `eenf extract --json` gives;
 - a garbage upload shows its error on the page, and the next upload works;
 - requests without the token get 401, with a wrong one 403; two uploads at once both finish;
 - Ctrl-C stops the server, and its upload folder is gone.
@@ -189,15 +191,57 @@ def main():
                 for p, r in zip(page, ref))
             check(same, f"the report's trace = `eenf reference --json` ({len(page)} vs {len(ref)} values)")
 
+        # the report as a reader sees it (no script in it runs: it is looked at, then left)
+        html = [n for n in os.listdir(downloads) if n.endswith(".html")]
+        if html:
+            driver.get("file://" + os.path.join(downloads, html[0]))
+            driver.save_screenshot(os.path.join(out, "3-report.png"))
+            driver.get(url)
+
+        # an event recording: its trace, its flicker map, and the report's trace against
+        # `eenf extract --json` on the same file
+        events = os.path.join(a.shared, "fixtures", "real-flicker", "jaer_MovingDarkBox.aedat")
+        extracted = json.loads(subprocess.run([eenf, "-q", "extract", events, "--json"], check=True,
+                                              capture_output=True, text=True).stdout)
+        for n in os.listdir(downloads):
+            os.remove(os.path.join(downloads, n))
+        driver.find_element(By.CSS_SELECTOR, "input[type=file]").send_keys(events)
+        WebDriverWait(driver, 300).until(
+            lambda d: (visible("results") and "jaer_MovingDarkBox" in
+                       d.find_element(By.ID, "trace").get_attribute("innerHTML")) or visible("error"))
+        driver.save_screenshot(os.path.join(out, "4-events.png"))
+        verdict = driver.find_element(By.ID, "verdict").text
+        check(visible("results") and "Hz grid" in verdict, f"events #verdict: {verdict}")
+        check(visible("flicker"), "events: the flicker map is shown")
+        driver.find_element(By.CSS_SELECTOR, "a#report").click()
+        report = None
+        for _ in range(100):
+            done = [n for n in os.listdir(downloads) if n.endswith(".html")]
+            if done:
+                report = open(os.path.join(downloads, done[0]), encoding="utf-8").read()
+                break
+            time.sleep(0.1)
+        if report:
+            start = report.index('id="trace-json" type="application/json">')
+            body = report[report.index(">", start) + 1:report.index("</script>", start)]
+            page = json.loads(body)["enf_hz"]
+            ref = extracted["enf_hz"]
+            same = len(page) == len(ref) and all(
+                (p is None and r is None) or (p is not None and r is not None and abs(p - r) < 1e-9)
+                for p, r in zip(page, ref))
+            check(same, f"events: the report's trace = `eenf extract --json` ({len(page)} vs {len(ref)} values)")
+        else:
+            check(False, "events: the report downloaded")
+
         driver.find_element(By.CSS_SELECTOR, "input[type=file]").send_keys(garbage)
         WebDriverWait(driver, 60).until(lambda d: visible("error"))
         error = driver.find_element(By.ID, "error").text
-        driver.save_screenshot(os.path.join(out, "4-garbage.png"))
+        driver.save_screenshot(os.path.join(out, "5-garbage.png"))
         check("garbage.wav" in error and "\n" not in error.strip(), f"garbage: {error}")
 
         driver.find_element(By.CSS_SELECTOR, "input[type=file]").send_keys(clip)
         WebDriverWait(driver, 300).until(lambda d: visible("results") or visible("error"))
-        driver.save_screenshot(os.path.join(out, "5-after-garbage.png"))
+        driver.save_screenshot(os.path.join(out, "6-after-garbage.png"))
         check(visible("results"), "the next upload works")
     finally:
         driver.quit()

@@ -107,3 +107,25 @@ pub fn plot_flicker_map(
         |root| flicker_map_chart(root, title, map),
     )
 }
+
+/// [`plot_flicker_map`]'s figure as SVG text.
+pub fn flicker_map_svg(title: &str, map: &eenf::flicker_map::FlickerMap) -> Result<String> {
+    render_svg(|root| flicker_map_chart(root, title, map))
+}
+
+/// The flicker map's title: the recording `name`, its whole line and the share of tiles where
+/// it stands out.
+pub fn flicker_map_title(name: &str, map: &eenf::flicker_map::FlickerMap) -> String {
+    let share = 100.0 * map.flickering_share();
+    match map.whole {
+        Some(l) => format!(
+            "{name}: flicker at {:.3} Hz, {}; it stands out in {share:.0} % of the tiles",
+            l.hz,
+            l.floor_db
+                .map_or(format!("prominence {:.1}", l.prominence), |db| format!(
+                    "{db:.0} dB over its floor"
+                ))
+        ),
+        None => format!("{name}: no flicker line measured"),
+    }
+}

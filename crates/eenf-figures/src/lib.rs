@@ -25,6 +25,6 @@ pub use comparison::{comparison_svg, plot_comparison, plot_methods, Series};
 pub use draw::title_name;
 pub use edits::{edits_svg, plot_edits};
 pub use extraction::{extraction_svg, plot_extraction};
-pub use flicker_map::plot_flicker_map;
+pub use flicker_map::{flicker_map_svg, flicker_map_title, plot_flicker_map};
 pub use spectrogram::plot_spectrogram;
 pub use summary::{plot_summary, SummaryBar};

@@ -5,7 +5,7 @@ use eenf::analysis::{Analysis, AnalysisSettings};
 use eenf::Result;
 use serde_json::Value;
 
-use crate::{comparison_svg, edits_svg, extraction_svg};
+use crate::{comparison_svg, edits_svg, extraction_svg, flicker_map_svg, flicker_map_title};
 
 /// The figures of an analysis, as SVG text (`None` where there is nothing to draw).
 #[derive(Debug, Clone, Default, serde::Serialize)]
@@ -17,6 +17,8 @@ pub struct Figures {
     pub matched: Option<String>,
     /// The hum's phase with the edits found (as `edits --plot`).
     pub edits: Option<String>,
+    /// Where in the view the flicker is (event files; as `flicker-map`).
+    pub flicker_map: Option<String>,
 }
 
 /// Draws the figures of `a`, whose file is called `name`.
@@ -24,6 +26,10 @@ pub fn figures(a: &Analysis, name: &str) -> Result<Figures> {
     let trace = Some(extraction_svg(name, &a.trace)?);
     let edits = match &a.edits {
         Ok(r) if !r.series.time_s.is_empty() => Some(edits_svg(name, r)?),
+        _ => None,
+    };
+    let flicker_map = match &a.flicker_map {
+        Some(Ok(m)) => Some(flicker_map_svg(&flicker_map_title(name, m), m)?),
         _ => None,
     };
     let mut matched = None;
@@ -54,15 +60,15 @@ pub fn figures(a: &Analysis, name: &str) -> Result<Figures> {
         trace,
         matched,
         edits,
+        flicker_map,
     })
 }
 
 /// The trace's verdict: `50 Hz grid, 300 estimates (1 s apart)`, or why there is no grid.
 pub fn trace_verdict(a: &Analysis) -> String {
-    let grid = a
-        .trace
-        .nominal_hz
-        .map_or("grid not known".to_string(), |g| format!("{g:.0} Hz grid"));
+    let grid = a.trace.grid().map_or("grid not known".to_string(), |g| {
+        format!("{} Hz grid", g.hz())
+    });
     format!(
         "{grid}, {} estimates ({} s apart)",
         a.estimates(),
@@ -77,7 +83,15 @@ pub fn match_verdicts(a: &Analysis) -> Vec<String> {
         .map(|m| {
             let store = m.store.display();
             match &m.result {
-                Err(e) => format!("{store}: {}", e.report()),
+                Err(e) => {
+                    // the library's message names the store already, where it is about it
+                    let why = e.report();
+                    if why.starts_with(&store.to_string()) {
+                        why
+                    } else {
+                        format!("{store}: {why}")
+                    }
+                }
                 Ok(l) => match l.report.placements.first() {
                     None => format!("{store}: no place fits"),
                     Some(p) => {
@@ -189,6 +203,11 @@ pub fn html_report(a: &Analysis, f: &Figures, facts: &ReportFacts) -> String {
     }
     if let Some(svg) = &f.trace {
         h.push_str(&format!("<div id=\"trace\">{svg}</div>\n"));
+    }
+    if let Some(svg) = &f.flicker_map {
+        h.push_str(&format!(
+            "<h3>Where the flicker is</h3>\n<div>{svg}</div>\n"
+        ));
     }
     h.push_str("<h2>When it was recorded</h2>\n");
     if a.matches.is_empty() {

@@ -115,6 +115,8 @@ impl Server {
     /// Checks the stores, makes the upload folder and binds the address (inside a tokio
     /// runtime).
     pub async fn bind(opts: ServeOptions) -> Result<Server, ServeError> {
+        // the page's options are the library's names (`window`, `verify`)
+        eenf_core::spelling::set_spelling(eenf_core::spelling::Spelling::Fields);
         for s in &opts.stores {
             if !s.exists() {
                 return Err(ServeError::Store(format!(

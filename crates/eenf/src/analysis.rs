@@ -144,6 +144,8 @@ pub struct Analysis {
     pub about: Value,
     /// The ENF trace.
     pub trace: Trace,
+    /// Where in the view the flicker is (event files only; as `flicker-map`).
+    pub flicker_map: Option<Result<crate::flicker_map::FlickerMap>>,
     /// `match` against each store, in the order given.
     pub matches: Vec<StoreMatch>,
     /// The search's query (its `alpha` is the verdict's level).
@@ -165,12 +167,15 @@ pub fn analyse(
 ) -> Result<Analysis> {
     let start = std::time::Instant::now();
     let kind = kind.unwrap_or_else(|| FileKind::of(path));
+    let mut flicker_map = None;
     let (trace, about) = match kind {
         FileKind::Events => {
             let open = settings.extract.input.open_options();
             let found = crate::inspect::inspect(path, &open)?;
             let opts = settings.extract.options()?;
             let trace = crate::extract::extract_file(path, &opts, progress)?;
+            let rec = crate::recording::Recording::file(path);
+            flicker_map = Some(crate::flicker_map::flicker_map(&rec, &open, None, progress));
             (trace, found.to_json(path))
         }
         FileKind::Video => {
@@ -219,6 +224,7 @@ pub fn analyse(
         kind,
         about,
         trace,
+        flicker_map,
         matches,
         query,
         edits,
@@ -288,9 +294,14 @@ impl Analysis {
         json!({
             "kind": self.kind,
             "about": self.about,
-            "grid_hz": self.trace.nominal_hz,
+            "grid_hz": self.trace.grid().map(|g| g.hz()),
             "estimates": self.estimates(),
             "trace": self.trace.to_json_value(),
+            "flicker_map": match &self.flicker_map {
+                None => Value::Null,
+                Some(Ok(m)) => serde_json::to_value(m).unwrap_or(Value::Null),
+                Some(Err(e)) => json!({"error": e.report()}),
+            },
             "matches": matches,
             "edits": edits,
             "seconds": self.seconds,

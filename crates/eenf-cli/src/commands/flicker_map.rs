@@ -39,21 +39,7 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         None => "no line measured".to_string(),
     };
     let share = 100.0 * map.flickering_share();
-    let title = match map.whole {
-        Some(l) => format!(
-            "{}: flicker at {:.3} Hz, {}; it stands out in {share:.0} % of the tiles",
-            eenf_figures::title_name(&a.file),
-            l.hz,
-            l.floor_db
-                .map_or(format!("prominence {:.1}", l.prominence), |db| format!(
-                    "{db:.0} dB over its floor"
-                ))
-        ),
-        None => format!(
-            "{}: no flicker line measured",
-            eenf_figures::title_name(&a.file)
-        ),
-    };
+    let title = eenf_figures::flicker_map_title(&eenf_figures::title_name(&a.file), &map);
     let picture = match (&a.output, a.json) {
         (Some(p), _) => Some(p.clone()),
         (None, false) => Some(PathBuf::from("flicker-map.png")),

@@ -97,6 +97,8 @@ function render(id, job) {
   const warnings = $("warnings");
   warnings.replaceChildren(...(a.trace.warnings || []).map((w) => el("li", w, "warning")));
   svgInto($("trace"), a.figures.trace);
+  svgInto($("flicker-map"), a.figures.flicker_map);
+  show("flicker", Boolean(a.figures.flicker_map));
 
   const match = $("match");
   match.replaceChildren();
