@@ -12,6 +12,8 @@ starts `eenf serve --store S --port 0`, uploads the clip on the page and checks:
   report's trace is the one `eenf extract --json` gives;
 - a garbage upload shows its error on the page, and the next upload works;
 - requests without the token get 401, with a wrong one 403; two uploads at once both finish;
+- every file of fixtures/hostile, uploaded, gives a result or a one-line error, and the server
+  goes on serving under 400 MB;
 - Ctrl-C stops the server, and its upload folder is gone.
 Screenshots of each state go to OUT (default target/page-check).
 
@@ -268,6 +270,35 @@ def main():
             time.sleep(0.2)
         states.append(s["state"])
     check(states == ["done", "done"], f"two uploads at once: {states}")
+
+    # every hostile fixture uploaded: each gives a result or a one-line error, and the server
+    # goes on, within its memory
+    hostile = os.path.join(a.shared, "fixtures", "hostile")
+    for n in sorted(os.listdir(hostile)):
+        path = os.path.join(hostile, n)
+        if n == "README.md" or not os.path.isfile(path):
+            continue
+        body, headers = multipart(path, n)
+        headers["X-Eenf-Token"] = token
+        code, r = status(base + "/api/analyses", headers, body)
+        if code != 202:
+            check(code in (400, 413), f"hostile {n}: refused at upload ({code})")
+            continue
+        t0, s = time.time(), {}
+        while time.time() - t0 < 120:
+            _, s = status(f"{base}/api/analyses/{json.loads(r)['id']}", {"X-Eenf-Token": token})
+            s = json.loads(s)
+            if s["state"] in ("done", "failed"):
+                break
+            time.sleep(0.2)
+        line = s.get("error") or (s.get("result") or {}).get("verdict", "")
+        check(s.get("state") in ("done", "failed") and "\n" not in line,
+              f"hostile {n}: {s.get('state')} in {time.time() - t0:.1f} s: {line[:100]}")
+    peak = next((int(x.split()[1]) // 1024 for x in open(f"/proc/{server.pid}/status")
+                 if x.startswith("VmHWM")), 0)
+    check(peak < 400, f"the server's peak memory over every upload: {peak} MB (< 400)")
+    code, _ = status(base + "/api/config", {"X-Eenf-Token": token})
+    check(code == 200, "the server still serves")
 
     server.send_signal(signal.SIGINT)
     try:
