@@ -14,6 +14,7 @@ mod cli_errors;
 mod cli_flags;
 mod cli_option_docs;
 mod cli_reliability;
+mod cli_serve;
 mod cli_simulation;
 mod memory_inputs;
 mod shared_archives;
