@@ -198,8 +198,11 @@ pub fn html_report(a: &Analysis, f: &Figures, facts: &ReportFacts) -> String {
     }
     h.push_str("</table>\n<h2>ENF trace</h2>\n");
     h.push_str(&format!("<p id=\"verdict\">{}</p>\n", e(&trace_verdict(a))));
-    for w in &a.trace.warnings {
-        h.push_str(&format!("<p class=\"warning\">{}</p>\n", e(w)));
+    if let Some(line) = a.trace.line_text() {
+        h.push_str(&format!("<p>{}</p>\n", e(&line)));
+    }
+    for w in a.trace.notices() {
+        h.push_str(&format!("<p class=\"warning\">{}</p>\n", e(&w)));
     }
     if let Some(svg) = &f.trace {
         h.push_str(&format!("<div id=\"trace\">{svg}</div>\n"));

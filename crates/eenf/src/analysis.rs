@@ -296,6 +296,8 @@ impl Analysis {
             "about": self.about,
             "grid_hz": self.trace.grid().map(|g| g.hz()),
             "estimates": self.estimates(),
+            "line": self.trace.line_text(),
+            "notices": self.trace.notices(),
             "trace": self.trace.to_json_value(),
             "flicker_map": match &self.flicker_map {
                 None => Value::Null,

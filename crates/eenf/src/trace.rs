@@ -436,6 +436,58 @@ impl Trace {
         ))
     }
 
+    /// The line the trace follows and how far it stands, in words: a sound's hum lines over
+    /// their floor, an event recording's flicker line; `None` for other traces.
+    pub fn line_text(&self) -> Option<String> {
+        match self.provenance.as_ref()? {
+            Provenance::Mains(MainsProvenance { hum: Some(h), .. }) => {
+                let grid = self.nominal_hz.unwrap_or(f64::NAN);
+                let lines: Vec<String> = h
+                    .carriers
+                    .iter()
+                    .filter_map(|k| {
+                        h.search
+                            .of_grid(grid)
+                            .find(|l| l.harmonic == *k)
+                            .map(|l| format!("{k} x f0 {:.1} dB", l.db))
+                    })
+                    .collect();
+                Some(format!(
+                    "hum lines traced (over their local floor, {:.1} dB needed, {:.0} s segments x {}): {}",
+                    h.search.lines.first().map_or(f64::NAN, |l| l.threshold_db),
+                    h.search.segment_s,
+                    h.search.segments,
+                    lines.join(", ")
+                ))
+            }
+            Provenance::Events(x) => x
+                .flicker
+                .map(|l| format!("flicker {:.3} Hz, {}", l.hz, l.strength())),
+            _ => None,
+        }
+    }
+
+    /// Everything the user should be told beside the values: the trace's warnings, an event
+    /// recording's notes and damage, why a sound's window changed and the flags its hum
+    /// raised, and the estimates at the noise level.
+    pub fn notices(&self) -> Vec<String> {
+        let mut out = self.warnings.clone();
+        match &self.provenance {
+            Some(Provenance::Mains(MainsProvenance { hum: Some(h), .. })) => {
+                out.extend(h.window_note.iter().cloned());
+                out.extend(h.plausibility.flags.iter().cloned());
+            }
+            Some(Provenance::Events(x)) => {
+                out.extend(x.notes.iter().cloned());
+                out.extend(x.damage.iter().cloned());
+            }
+            _ => {}
+        }
+        out.extend(self.noise_note());
+        out.dedup();
+        out
+    }
+
     /// Mean of the finite estimates (NaN when there are none).
     pub fn mean_hz(&self) -> f64 {
         let (sum, n) = self

@@ -53,25 +53,10 @@ pub fn run(a: Args, progress: Progress) -> Result<()> {
         params.peak,
         started.elapsed().as_secs_f64()
     );
+    if let Some(lines) = trace.line_text() {
+        eprintln!("{lines}");
+    }
     if let Some(Provenance::Mains(MainsProvenance { hum: Some(h), .. })) = &trace.provenance {
-        let grid = trace.nominal_hz.unwrap_or(f64::NAN);
-        let lines: Vec<String> = h
-            .carriers
-            .iter()
-            .filter_map(|k| {
-                h.search
-                    .of_grid(grid)
-                    .find(|l| l.harmonic == *k)
-                    .map(|l| format!("{k} x f0 {:.1} dB", l.db))
-            })
-            .collect();
-        eprintln!(
-            "hum lines traced (over their local floor, {:.1} dB needed, {:.0} s segments x {}): {}",
-            h.search.lines.first().map_or(f64::NAN, |l| l.threshold_db),
-            h.search.segment_s,
-            h.search.segments,
-            lines.join(", ")
-        );
         if let Some(note) = &h.window_note {
             eprintln!("note: {note}");
         }

@@ -95,7 +95,9 @@ function render(id, job) {
   show("progress", false);
   $("verdict").textContent = a.verdict;
   const warnings = $("warnings");
-  warnings.replaceChildren(...(a.trace.warnings || []).map((w) => el("li", w, "warning")));
+  const notes = (a.line ? [el("li", a.line)] : []).concat(
+    (a.notices || []).map((w) => el("li", w, "warning")));
+  warnings.replaceChildren(...notes);
   svgInto($("trace"), a.figures.trace);
   svgInto($("flicker-map"), a.figures.flicker_map);
   show("flicker", Boolean(a.figures.flicker_map));
