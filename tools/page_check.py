@@ -85,6 +85,28 @@ def multipart(path, name):
     return body, {"Content-Type": f"multipart/form-data; boundary={boundary}"}
 
 
+def downloaded_report(downloads):
+    """The report's HTML once the browser has saved it (None after 10 s)."""
+    for _ in range(100):
+        done = [n for n in os.listdir(downloads) if n.endswith(".html")]
+        if done:
+            return open(os.path.join(downloads, done[0]), encoding="utf-8").read()
+        time.sleep(0.1)
+    return None
+
+
+def same_trace(report, reference):
+    """Whether the report's trace (its `trace-json` script) holds `reference`'s values; and
+    the two lengths."""
+    start = report.index('id="trace-json" type="application/json">')
+    body = report[report.index(">", start) + 1:report.index("</script>", start)]
+    page, ref = json.loads(body)["enf_hz"], reference["enf_hz"]
+    same = len(page) == len(ref) and all(
+        (p is None and r is None) or (p is not None and r is not None and abs(p - r) < 1e-9)
+        for p, r in zip(page, ref))
+    return same, len(page), len(ref)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("eenf")
@@ -172,26 +194,13 @@ def main():
         edits = driver.find_element(By.ID, "edits").text
         check(len(edits) > 10, f"#edits: {edits.splitlines()[0] if edits else ''}")
 
-        link = driver.find_element(By.CSS_SELECTOR, "a#report")
-        link.click()
-        report = None
-        for _ in range(100):
-            done = [n for n in os.listdir(downloads) if n.endswith(".html")]
-            if done:
-                report = open(os.path.join(downloads, done[0]), encoding="utf-8").read()
-                break
-            time.sleep(0.1)
+        driver.find_element(By.CSS_SELECTOR, "a#report").click()
+        report = downloaded_report(downloads)
         check(report is not None, "the report downloaded")
         if report:
             check(digest in report, f"the report holds the clip's SHA-256 {digest[:16]}…")
-            start = report.index('id="trace-json" type="application/json">')
-            body = report[report.index(">", start) + 1:report.index("</script>", start)]
-            page = json.loads(body)["enf_hz"]
-            ref = cli["enf_hz"]
-            same = len(page) == len(ref) and all(
-                (p is None and r is None) or (p is not None and r is not None and abs(p - r) < 1e-9)
-                for p, r in zip(page, ref))
-            check(same, f"the report's trace = `eenf reference --json` ({len(page)} vs {len(ref)} values)")
+            same, n_page, n_ref = same_trace(report, cli)
+            check(same, f"the report's trace = `eenf reference --json` ({n_page} vs {n_ref} values)")
 
         # the report as a reader sees it (no script in it runs: it is looked at, then left)
         html = [n for n in os.listdir(downloads) if n.endswith(".html")]
@@ -216,24 +225,11 @@ def main():
         check(visible("results") and "Hz grid" in verdict, f"events #verdict: {verdict}")
         check(visible("flicker"), "events: the flicker map is shown")
         driver.find_element(By.CSS_SELECTOR, "a#report").click()
-        report = None
-        for _ in range(100):
-            done = [n for n in os.listdir(downloads) if n.endswith(".html")]
-            if done:
-                report = open(os.path.join(downloads, done[0]), encoding="utf-8").read()
-                break
-            time.sleep(0.1)
+        report = downloaded_report(downloads)
+        check(report is not None, "events: the report downloaded")
         if report:
-            start = report.index('id="trace-json" type="application/json">')
-            body = report[report.index(">", start) + 1:report.index("</script>", start)]
-            page = json.loads(body)["enf_hz"]
-            ref = extracted["enf_hz"]
-            same = len(page) == len(ref) and all(
-                (p is None and r is None) or (p is not None and r is not None and abs(p - r) < 1e-9)
-                for p, r in zip(page, ref))
-            check(same, f"events: the report's trace = `eenf extract --json` ({len(page)} vs {len(ref)} values)")
-        else:
-            check(False, "events: the report downloaded")
+            same, n_page, n_ref = same_trace(report, extracted)
+            check(same, f"events: the report's trace = `eenf extract --json` ({n_page} vs {n_ref} values)")
 
         driver.find_element(By.CSS_SELECTOR, "input[type=file]").send_keys(garbage)
         WebDriverWait(driver, 60).until(lambda d: visible("error"))

@@ -416,3 +416,22 @@ fn an_upload_over_the_cap_is_refused_and_a_name_never_becomes_a_path() {
     // the server goes on
     assert_eq!(get(&r, "/api/config").0, 200);
 }
+
+#[test]
+fn the_pages_options_reach_every_step_that_takes_them() {
+    use eenf::analysis::AnalysisSettings;
+    use eenf_core::{Grid, Nominal};
+    let s = AnalysisSettings::from_json(r#"{"nominal": "60", "verify": "2022-08-17T09:20:34Z"}"#)
+        .unwrap();
+    let sixty = Nominal::Grid(Grid::Hz60);
+    assert_eq!(s.tracker.nominal, sixty, "sound");
+    assert_eq!(s.extract.tracker.nominal, sixty, "events");
+    assert_eq!(s.video.nominal, sixty, "video");
+    assert_eq!(s.edits.nominal, sixty, "edits");
+    assert_eq!(s.matching.verify.as_deref(), Some("2022-08-17T09:20:34Z"));
+    let d = AnalysisSettings::default();
+    assert_eq!(d.tracker.nominal, Nominal::Auto);
+    for bad in [r#"{"no_such_option": 1}"#, r#"{"window": -3}"#, "[1]", "{"] {
+        assert!(AnalysisSettings::from_json(bad).is_err(), "{bad}");
+    }
+}

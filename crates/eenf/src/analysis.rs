@@ -92,21 +92,7 @@ impl AnalysisSettings {
     /// (`nominal` sets the grid of every step), then each set is checked.
     pub fn from_json(json: &str) -> std::result::Result<Self, OptionError> {
         let mut s = AnalysisSettings::default();
-        let value: Value =
-            serde_json::from_str(json).map_err(|e| OptionError::NotAnObject(e.to_string()))?;
-        let Value::Object(map) = value else {
-            return Err(OptionError::NotAnObject(format!("got {value}")));
-        };
-        for (name, v) in &map {
-            let mut taken = false;
-            for set in s.sets() {
-                taken |= set.set(name, v)?;
-            }
-            if !taken {
-                return Err(OptionError::Unknown(name.clone()));
-            }
-        }
-        s.sets().into_iter().try_for_each(|set| set.check())?;
+        crate::options::apply_json_to_all(&mut s.sets(), json)?;
         Ok(s)
     }
 

@@ -39,6 +39,16 @@ pub trait OptionSet: fmt::Debug {
 /// Fills `sets` from a JSON object of options (each name goes to the first set that has it),
 /// then checks each set. A name no set has is an [`OptionError::Unknown`].
 pub fn apply_json(sets: &mut [&mut dyn OptionSet], json: &str) -> Result<(), OptionError> {
+    apply(sets, json, false)
+}
+
+/// As [`apply_json`], but each name goes to every set that has it: for options shared by the
+/// steps of one analysis (`nominal` is the grid of each).
+pub fn apply_json_to_all(sets: &mut [&mut dyn OptionSet], json: &str) -> Result<(), OptionError> {
+    apply(sets, json, true)
+}
+
+fn apply(sets: &mut [&mut dyn OptionSet], json: &str, all: bool) -> Result<(), OptionError> {
     let value: Value =
         serde_json::from_str(json).map_err(|e| OptionError::NotAnObject(e.to_string()))?;
     let Value::Object(map) = value else {
@@ -49,7 +59,9 @@ pub fn apply_json(sets: &mut [&mut dyn OptionSet], json: &str) -> Result<(), Opt
         for s in sets.iter_mut() {
             if s.set(name, v)? {
                 taken = true;
-                break;
+                if !all {
+                    break;
+                }
             }
         }
         if !taken {
