@@ -113,6 +113,8 @@ def main():
     ap.add_argument("shared")
     ap.add_argument("--out", default="target/page-check")
     a = ap.parse_args()
+    # chromedriver takes only canonical paths for uploads (no `..`)
+    a.shared = os.path.realpath(a.shared)
     eenf = os.path.abspath(a.eenf)
     out = os.path.abspath(a.out)
     os.makedirs(out, exist_ok=True)
