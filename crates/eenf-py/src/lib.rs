@@ -568,6 +568,71 @@ fn refdb_build(
     .map_err(py_err)
 }
 
+/// `eenf refdb fetch`: fetches `start` to `end` (default now) of a grid operator's data
+/// (`gb`, `se`, `ch`, `osf`) into the store at `store`; returns what was fetched, as JSON
+/// text. The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (source, store, start, end=None, endpoint=None, grid=None, cache=None, retries=3, wait=true))]
+#[allow(clippy::too_many_arguments)]
+fn refdb_fetch(
+    py: Python<'_>,
+    source: &str,
+    store: PathBuf,
+    start: &str,
+    end: Option<&str>,
+    endpoint: Option<String>,
+    grid: Option<String>,
+    cache: Option<PathBuf>,
+    retries: u32,
+    wait: bool,
+) -> PyResult<String> {
+    use eenf::fetch;
+    let req = (|| -> eenf::Result<fetch::FetchRequest> {
+        Ok(fetch::FetchRequest {
+            source: fetch::Source::parse(source)?,
+            from_unix_s: fetch::parse_day_or_time(start, false)?,
+            to_unix_s: match end {
+                Some(t) => fetch::parse_day_or_time(t, true)?,
+                None => f64::INFINITY,
+            },
+            store,
+            cache: cache.unwrap_or_else(fetch::default_cache),
+            endpoint,
+            grid,
+            retries,
+            wait,
+        })
+    })()
+    .map_err(py_err)?;
+    py.detach(|| {
+        Ok(fetch::fetch(&req, &Progress::hidden())?
+            .to_json()
+            .to_string())
+    })
+    .map_err(py_err)
+}
+
+/// `eenf refdb update`: brings every fetched grid of the store at `store` up to now; returns
+/// what each source gave, as JSON text (a list). The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (store, cache=None, retries=3, wait=true))]
+fn refdb_update(
+    py: Python<'_>,
+    store: PathBuf,
+    cache: Option<PathBuf>,
+    retries: u32,
+    wait: bool,
+) -> PyResult<String> {
+    use eenf::fetch;
+    let cache = cache.unwrap_or_else(fetch::default_cache);
+    py.detach(|| {
+        let done = fetch::update(&store, &cache, retries, wait, &Progress::hidden())?;
+        let list: Vec<_> = done.iter().map(|f| f.to_json()).collect();
+        Ok(serde_json::Value::from(list).to_string())
+    })
+    .map_err(py_err)
+}
+
 /// `eenf simulate`: writes a recording and its truth; returns what was written, as JSON text.
 /// The GIL is released.
 #[pyfunction]
@@ -732,6 +797,8 @@ fn _eenf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(refdb_build, m)?)?;
+    m.add_function(wrap_pyfunction!(refdb_fetch, m)?)?;
+    m.add_function(wrap_pyfunction!(refdb_update, m)?)?;
     m.add_function(wrap_pyfunction!(write_events, m)?)?;
     m.add_function(wrap_pyfunction!(edits, m)?)?;
     m.add_function(wrap_pyfunction!(edits_samples, m)?)?;

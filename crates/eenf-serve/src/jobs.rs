@@ -181,6 +181,21 @@ fn named(text: &str, path: &Path, name: &str) -> String {
     text.replace(&path.display().to_string(), name)
 }
 
+/// [`named`] on every string of a JSON value, in place (a name with quotes in it stays a
+/// string: the JSON is never rewritten as text).
+fn name_strings(v: &mut serde_json::Value, path: &Path, name: &str) {
+    match v {
+        serde_json::Value::String(s) => *s = named(s, path, name),
+        serde_json::Value::Array(items) => {
+            items.iter_mut().for_each(|x| name_strings(x, path, name))
+        }
+        serde_json::Value::Object(map) => {
+            map.values_mut().for_each(|x| name_strings(x, path, name))
+        }
+        _ => {}
+    }
+}
+
 /// What one analysis needs.
 pub(crate) struct Request {
     pub path: PathBuf,
@@ -206,8 +221,7 @@ pub(crate) fn run(r: &Request, progress: &Progress) -> Result<Finished, String> 
     let name = Path::new(&r.name);
     let mut page = a.to_json(name);
     // the library's messages name the upload's server-side path: the page names the file
-    let text = named(&page.to_string(), &r.path, &r.name);
-    page = serde_json::from_str(&text).unwrap_or(page);
+    name_strings(&mut page, &r.path, &r.name);
     page["verdict"] = json!(trace_verdict(&a));
     page["match_verdicts"] = json!(match_verdicts(&a)
         .iter()

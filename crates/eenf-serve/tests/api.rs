@@ -182,16 +182,13 @@ fn hum_wav(path: &Path, seed: u64) {
     w.finalize().unwrap();
 }
 
+/// Every file under `dir`, in its subfolders too.
 fn files_in(dir: &Path) -> Vec<PathBuf> {
-    walk(dir)
-}
-
-fn walk(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     for e in std::fs::read_dir(dir).unwrap().flatten() {
         let p = e.path();
         if p.is_dir() {
-            out.extend(walk(&p));
+            out.extend(files_in(&p));
         } else {
             out.push(p);
         }

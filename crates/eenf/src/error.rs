@@ -62,6 +62,10 @@ pub enum Error {
     /// A simulation that cannot be built as asked.
     #[error("{0}")]
     Simulation(String),
+    /// A grid operator's server that did not give what was asked (no network, an HTTP error,
+    /// a body cut short, a format that changed).
+    #[error("{0}")]
+    Fetch(String),
     /// An output that cannot be written where it was asked to go.
     #[error("{0}")]
     Output(String),
@@ -99,6 +103,8 @@ pub enum Area {
     Archive,
     /// Simulation ([`Error::Simulation`], [`Error::Mains`]).
     Simulation,
+    /// Downloads from grid operators ([`Error::Fetch`]).
+    Fetch,
     /// An output ([`Error::Output`]).
     Output,
 }
@@ -137,6 +143,7 @@ impl Error {
             Error::Archive(_) => Area::Archive,
             Error::Simulation(_) | Error::Mains(_) => Area::Simulation,
             Error::Output(_) => Area::Output,
+            Error::Fetch(_) => Area::Fetch,
             Error::Context { .. } => unreachable!("root() passes every context"),
         }
     }

@@ -36,6 +36,7 @@ pub mod edits;
 pub mod error;
 pub mod evaluate;
 pub mod extract;
+pub mod fetch;
 pub mod flac_mask;
 pub mod flicker_map;
 pub mod inspect;

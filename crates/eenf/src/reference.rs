@@ -411,6 +411,9 @@ pub struct StoreBuild {
     pub index_step_s: Option<f64>,
     /// Wait for another build that holds the store (else fail at once).
     pub wait: bool,
+    /// Where the inputs were fetched from, recorded in the manifest of every grid they go
+    /// into (`refdb fetch`).
+    pub fetched: Option<crate::refdb::FetchedFrom>,
 }
 
 /// A grid a build changed: its name and how many values it now holds.
@@ -544,7 +547,10 @@ pub fn build_store(
     }
     bar.finish_and_clear();
     let mut built = Vec::new();
-    for s in series {
+    for mut s in series {
+        if let Some(from) = &build.fetched {
+            s.meta.record_fetch(from);
+        }
         let grid = s.meta.grid.clone();
         let values = s.commit()?;
         StoredGrid::remove_orphans(store, &grid)?;

@@ -1,8 +1,9 @@
-//! `eenf refdb build|info`: the reference store.
+//! `eenf refdb build|fetch|update|info`: the reference store.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
+use eenf::fetch::{self, Source};
 use eenf::progress::Progress;
 use eenf::refdb::{GridValues, StoreLock, StoredGrid};
 use eenf::reference::build_store;
@@ -18,6 +19,14 @@ pub enum Cmd {
     /// a store (created when missing). One series per grid; new values replace old, gaps stay
     /// gaps.
     Build(BuildArgs),
+    /// Fetch a span of a grid operator's frequency data into a store (created when missing):
+    /// gb (National Grid ESO / NESO, monthly files, 1 s, UTC), se (Svenska kraftnät's control
+    /// room, an hour per request, UTC), ch (Swissgrid, its last minutes only), osf (a file of
+    /// the OSF/WETI database, at the address given with --endpoint). Downloads are kept in a
+    /// cache and resumed when cut; the store changes only when all are in.
+    Fetch(FetchArgs),
+    /// Bring every fetched grid of a store up to now, from the sources its manifest records.
+    Update(UpdateArgs),
     /// Show what a store covers, in UTC and in the zone asked for.
     Info {
         /// The store (a folder).
@@ -45,14 +54,86 @@ pub struct BuildArgs {
     pub how: StoreInputArgs,
 }
 
-fn build(a: BuildArgs, progress: Progress) -> Result<()> {
-    let build = a.how.build(a.inputs.clone())?;
-    let built = build_store(&a.store, &build, &progress, || {
+/// Arguments of `eenf refdb fetch`.
+#[derive(Debug, clap::Args)]
+pub struct FetchArgs {
+    /// The source: gb, se, ch or osf.
+    #[arg(value_parser = source_name)]
+    pub source: Source,
+    /// Start: a day (2024-06-01, from its start in UTC) or a time with its zone.
+    #[arg(long)]
+    pub from: String,
+    /// End: a day (2024-06-30, to its end in UTC) or a time with its zone (default: now).
+    #[arg(long)]
+    pub to: Option<String>,
+    /// The store (a folder; created when missing).
+    #[arg(long, default_value = "references")]
+    pub store: PathBuf,
+    /// Ask this address instead of the operator's (a mirror; its files must be in the
+    /// operator's format).
+    #[arg(long)]
+    pub endpoint: Option<String>,
+    /// The grid's name in the store (default: the source's: gb, se, ch, ce).
+    #[arg(long)]
+    pub grid: Option<String>,
+    #[command(flatten)]
+    pub download: DownloadArgs,
+}
+
+/// Arguments of `eenf refdb update`.
+#[derive(Debug, clap::Args)]
+pub struct UpdateArgs {
+    /// The store (a folder).
+    pub store: PathBuf,
+    #[command(flatten)]
+    pub download: DownloadArgs,
+}
+
+/// How downloads are made.
+#[derive(Debug, clap::Args)]
+pub struct DownloadArgs {
+    /// Where downloads are kept and resumed from (default: ~/.cache/eenf/fetch).
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+    /// Retries after a failure that may pass (no connection, a cut, a server error, 429).
+    #[arg(long, default_value_t = 3)]
+    pub retries: u32,
+    /// Fail at once when another build is changing the store, instead of waiting for it.
+    #[arg(long)]
+    pub no_wait: bool,
+}
+
+impl DownloadArgs {
+    fn cache(&self) -> PathBuf {
+        self.cache.clone().unwrap_or_else(fetch::default_cache)
+    }
+}
+
+fn source_name(s: &str) -> Result<Source, String> {
+    Source::from_name(s)
+        .ok_or_else(|| format!("{s:?}: expected one of {}", Source::NAMES.join(", ")))
+}
+
+fn report_fetch(f: &fetch::Fetched, store: &Path) {
+    for p in &f.files {
         eprintln!(
-            "{}: another build is changing this store; waiting for it",
-            a.store.display()
-        )
-    })?;
+            "{}: {} {}",
+            f.source.name(),
+            if p.cached {
+                "in the cache:"
+            } else {
+                "downloaded"
+            },
+            p.url
+        );
+    }
+    for n in &f.notes {
+        eprintln!("note: {n}");
+    }
+    report_built(&f.built, store);
+}
+
+fn report_built(built: &eenf::reference::StoreBuilt, store: &Path) {
     for (path, report) in &built.archives {
         eprintln!("{}: {report}", path.display());
         for w in &report.warnings {
@@ -62,11 +143,59 @@ fn build(a: BuildArgs, progress: Progress) -> Result<()> {
     for g in &built.grids {
         eprintln!(
             "{}: grid {} now holds {} values",
-            a.store.display(),
+            store.display(),
             g.grid,
             g.values
         );
     }
+}
+
+fn fetch_into(a: FetchArgs, progress: Progress) -> Result<()> {
+    let req = fetch::FetchRequest {
+        source: a.source,
+        from_unix_s: fetch::parse_day_or_time(&a.from, false)?,
+        to_unix_s: match &a.to {
+            Some(t) => fetch::parse_day_or_time(t, true)?,
+            None => f64::INFINITY,
+        },
+        store: a.store.clone(),
+        cache: a.download.cache(),
+        endpoint: a.endpoint.clone(),
+        grid: a.grid.clone(),
+        retries: a.download.retries,
+        wait: !a.download.no_wait,
+    };
+    let fetched = fetch::fetch(&req, &progress)?;
+    report_fetch(&fetched, &a.store);
+    info(&a.store, None)
+}
+
+fn update(a: UpdateArgs, progress: Progress) -> Result<()> {
+    let done = fetch::update(
+        &a.store,
+        &a.download.cache(),
+        a.download.retries,
+        !a.download.no_wait,
+        &progress,
+    )?;
+    if done.is_empty() {
+        eprintln!("{}: every fetched grid is up to date", a.store.display());
+    }
+    for f in &done {
+        report_fetch(f, &a.store);
+    }
+    info(&a.store, None)
+}
+
+fn build(a: BuildArgs, progress: Progress) -> Result<()> {
+    let build = a.how.build(a.inputs.clone())?;
+    let built = build_store(&a.store, &build, &progress, || {
+        eprintln!(
+            "{}: another build is changing this store; waiting for it",
+            a.store.display()
+        )
+    })?;
+    report_built(&built, &a.store);
     info(&a.store, a.how.tz.as_ref())
 }
 
@@ -115,6 +244,37 @@ fn info(store: &Path, zone: Option<&Zone>) -> Result<()> {
                 )
             }
         );
+        for f in &m.fetched {
+            let described = Source::from_name(&f.source)
+                .map(|s| s.describe())
+                .unwrap_or("an unknown source");
+            outln!("fetched     {} from {} ({described})", f.source, f.endpoint);
+            let last = f.files.iter().map(|x| x.retrieved_utc.as_str()).max();
+            outln!(
+                "            {} file{}, {:.1} MB, last retrieved {}",
+                f.files.len(),
+                if f.files.len() == 1 { "" } else { "s" },
+                f.files.iter().map(|x| x.bytes).sum::<u64>() as f64 / 1e6,
+                last.unwrap_or("-")
+            );
+            // the latest few; every one is in the manifest
+            let shown = f.files.len().saturating_sub(12);
+            if shown > 0 {
+                outln!(
+                    "            ({shown} earlier files listed in {}.json)",
+                    m.grid
+                );
+            }
+            for x in &f.files[shown..] {
+                outln!(
+                    "            {}  sha256 {}  {} bytes  {}",
+                    x.retrieved_utc,
+                    x.sha256,
+                    x.bytes,
+                    x.url
+                );
+            }
+        }
         outln!();
     }
     Ok(())
@@ -124,6 +284,8 @@ fn info(store: &Path, zone: Option<&Zone>) -> Result<()> {
 pub fn run(cmd: Cmd, progress: Progress) -> Result<()> {
     match cmd {
         Cmd::Build(a) => build(a, progress),
+        Cmd::Fetch(a) => fetch_into(a, progress),
+        Cmd::Update(a) => update(a, progress),
         Cmd::Info { store, tz } => info(&store, tz.as_ref()),
     }
 }

@@ -60,6 +60,8 @@ __all__ = [
     "simulate_dataset",
     "edits",
     "refdb_build",
+    "refdb_fetch",
+    "refdb_update",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -542,6 +544,55 @@ def refdb_build(store: PathLike, *inputs: PathLike, **params: Any) -> Dict[str, 
     for each archive, its ``summary`` and ``report`` (layout, zone, rows read and dropped)."""
     return json.loads(
         _eenf.refdb_build(os.fspath(store), [os.fspath(i) for i in inputs], _options(params))
+    )
+
+
+def refdb_fetch(
+    source: str,
+    store: PathLike,
+    start: str,
+    end: Optional[str] = None,
+    *,
+    endpoint: Optional[str] = None,
+    grid: Optional[str] = None,
+    cache: Optional[PathLike] = None,
+    retries: int = 3,
+    wait: bool = True,
+) -> Dict[str, Any]:
+    """``eenf refdb fetch``: fetches ``start`` to ``end`` (a day such as ``"2023-01-01"``, or a
+    time with its zone; ``end`` defaults to now) of a grid operator's frequency data into the
+    store ``store``: ``"gb"`` (National Grid ESO / NESO monthly files), ``"se"`` (Svenska
+    kraftnät's control room), ``"ch"`` (Swissgrid, its last minutes only) or ``"osf"`` (an OSF
+    database file at ``endpoint``). ``endpoint`` asks a mirror instead of the operator.
+    Downloads are kept in ``cache`` (default ``~/.cache/eenf/fetch``) and resumed when cut;
+    the store changes only when all are in, with each file's address, time of retrieval and
+    SHA-256 in its manifest. Returns the ``files`` (``url``, ``path``, ``cached``), the
+    ``grids`` changed and the ``notes``."""
+    return json.loads(
+        _eenf.refdb_fetch(
+            source,
+            os.fspath(store),
+            start,
+            end,
+            endpoint,
+            grid,
+            None if cache is None else os.fspath(cache),
+            retries,
+            wait,
+        )
+    )
+
+
+def refdb_update(
+    store: PathLike, *, cache: Optional[PathLike] = None, retries: int = 3, wait: bool = True
+) -> List[Dict[str, Any]]:
+    """``eenf refdb update``: brings every fetched grid of ``store`` up to now, asking each
+    source its manifest records for what lies after the grid's last value. Returns what each
+    source gave, as :func:`refdb_fetch` does."""
+    return json.loads(
+        _eenf.refdb_update(
+            os.fspath(store), None if cache is None else os.fspath(cache), retries, wait
+        )
     )
 
 

@@ -215,6 +215,21 @@ def refdb_build(
     no_wait: bool = False,
     index_step: Optional[float] = None,
 ) -> Dict[str, Any]: ...
+def refdb_fetch(
+    source: Literal["gb", "se", "ch", "osf"],
+    store: PathLike,
+    start: str,
+    end: Optional[str] = None,
+    *,
+    endpoint: Optional[str] = None,
+    grid: Optional[str] = None,
+    cache: Optional[PathLike] = None,
+    retries: int = 3,
+    wait: bool = True,
+) -> Dict[str, Any]: ...
+def refdb_update(
+    store: PathLike, *, cache: Optional[PathLike] = None, retries: int = 3, wait: bool = True
+) -> List[Dict[str, Any]]: ...
 def simulate(
     output: Optional[PathLike] = None,
     *,

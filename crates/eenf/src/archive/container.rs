@@ -52,6 +52,11 @@ pub(super) fn for_each_member(path: &Path, each: &mut MemberFn<'_>) -> Result<Ve
     let n = open()?.read(&mut head).with_context(|| format!("{name}"))?;
     let mut warnings = Vec::new();
     match container_of(&head[..n]) {
+        // an operator's JSON answer, read as the table it holds
+        Container::Text if super::operator_json::looks_like_json(&head[..n]) => {
+            let (kind, table) = super::operator_json::to_table(path)?;
+            each(Some(kind.describe()), &mut std::io::Cursor::new(table))?;
+        }
         Container::Text => each(None, &mut BufReader::new(open()?))?,
         Container::Gzip => {
             let gz = flate2::read::MultiGzDecoder::new(BufReader::new(open()?));

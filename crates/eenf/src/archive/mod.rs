@@ -33,10 +33,12 @@ use crate::time::Zone;
 mod container;
 mod dates;
 mod layout;
+mod operator_json;
 mod state;
 
 pub use dates::parse_date_time;
 pub use layout::{sniff, Layout, TimeColumns, ZoneRule};
+pub use operator_json::OperatorJson;
 
 use container::{container_of, first_lines, for_each_member, read_line, Container};
 use state::{ClockNote, ImportState};
@@ -353,6 +355,10 @@ pub fn is_archive(path: &Path) -> bool {
     if container_of(&head[..n]) != Container::Text {
         return true;
     }
+    if operator_json::looks_like_json(&head[..n]) {
+        // an operator's JSON answer (one long line), or an eenf JSON trace
+        return operator_json::kind_of(path).is_some();
+    }
     let Ok(f) = File::open(path) else {
         return false;
     };
@@ -363,7 +369,7 @@ pub fn is_archive(path: &Path) -> bool {
         .first()
         .is_some_and(|l| l.trim_start().starts_with('{'))
     {
-        return false; // an eenf JSON trace
+        return operator_json::kind_of(path).is_some();
     }
     let header = lines
         .first()

@@ -435,6 +435,7 @@ impl StoreInputSettings {
             start,
             index_step_s: self.index_step,
             wait: !self.no_wait,
+            fetched: None,
         })
     }
 }

@@ -61,6 +61,66 @@ pub struct RefMeta {
     /// The files holding the values, in order; absent in stores with one values file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub parts: Option<Vec<Part>>,
+    /// Where values were fetched from (`refdb fetch`): each source and the files it gave.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fetched: Vec<FetchedFrom>,
+}
+
+/// A grid operator's source that values of a grid were fetched from, and every file it gave.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FetchedFrom {
+    /// The source's name (`gb`, `se`, `ch`), as `refdb fetch` takes it.
+    pub source: String,
+    /// The address asked (the operator's, or a mirror's given with `--endpoint`); `refdb
+    /// update` asks it again.
+    pub endpoint: String,
+    /// The files, one per address; a file fetched again replaces its entry.
+    pub files: Vec<FetchedFile>,
+}
+
+/// One file fetched from a grid operator.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FetchedFile {
+    /// Its address.
+    pub url: String,
+    /// When it was retrieved, UTC (RFC 3339).
+    pub retrieved_utc: String,
+    /// SHA-256 of its bytes, hex.
+    pub sha256: String,
+    /// Its size, bytes.
+    pub bytes: u64,
+}
+
+impl FetchedFrom {
+    /// Adds `other`'s files, replacing those with the same address.
+    pub fn absorb(&mut self, other: &FetchedFrom) {
+        for f in &other.files {
+            match self.files.iter_mut().find(|g| g.url == f.url) {
+                Some(g) => *g = f.clone(),
+                None => self.files.push(f.clone()),
+            }
+        }
+    }
+}
+
+impl RefMeta {
+    /// Records that values were fetched from `from` (merged with earlier fetches from the
+    /// same source and address).
+    pub fn record_fetch(&mut self, from: &FetchedFrom) {
+        match self
+            .fetched
+            .iter_mut()
+            .find(|f| f.source == from.source && f.endpoint == from.endpoint)
+        {
+            Some(f) => f.absorb(from),
+            None => self.fetched.push(from.clone()),
+        }
+    }
+
+    /// Time of the last value, Unix seconds (the start when empty).
+    pub fn end_unix_s(&self) -> f64 {
+        self.start_unix_s + self.count.saturating_sub(1) as f64 * self.step_s
+    }
 }
 
 /// One file of a grid's values: `count` values from index `first` of the series.
@@ -273,6 +333,7 @@ impl StoredGrid {
                 values_file: None,
                 values_crc32: None,
                 parts: None,
+                fetched: Vec::new(),
             },
             values: Vec::new(),
         }
@@ -305,11 +366,12 @@ impl StoredGrid {
     pub fn load_meta(dir: &Path, grid: &str) -> Result<RefMeta> {
         check_grid_name(grid)?;
         let json = manifest(dir, grid);
-        // a manifest is a few hundred bytes: a large one is not read into memory
+        // a manifest is a few kB (a fetched decade's files, a few hundred kB): a large one is
+        // not read into memory
         let size = std::fs::metadata(&json)
             .with_context(|| format!("{}", json.display()))?
             .len();
-        if size > 1 << 20 {
+        if size > 8 << 20 {
             fail!(
                 Store,
                 "{}: {size} bytes: not an eenf reference store manifest",
