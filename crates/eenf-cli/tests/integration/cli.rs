@@ -24,6 +24,30 @@ pub fn ok(args: &[&str], dir: &Path) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+/// Runs `eenf ARGS`, which must succeed: its stdout and stderr.
+pub fn ok_out_err(args: &[&str], dir: &Path) -> (String, String) {
+    let out = eenf(args, dir);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "eenf {args:?}: {err}");
+    (String::from_utf8_lossy(&out.stdout).into_owned(), err)
+}
+
+/// Runs `eenf ARGS`, which must fail in one line without a panic; that line.
+pub fn refused(args: &[&str], dir: &Path) -> String {
+    let out = eenf(args, dir);
+    let err = String::from_utf8_lossy(&out.stderr).trim().to_string();
+    assert!(!out.status.success(), "eenf {args:?} succeeded: {err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+/// A mains frequency that is a known function of the UTC time: what the archives and the
+/// operators' answers the tests write hold.
+pub fn truth_hz(unix_s: f64) -> f64 {
+    50.0 + 0.03 * (unix_s / 700.0).sin() + 0.01 * (unix_s / 97.0).cos()
+}
+
 /// Runs `eenf ARGS`, which must fail without a panic; its stderr.
 pub fn fails(args: &[&str], dir: &Path) -> String {
     let out = eenf(args, dir);

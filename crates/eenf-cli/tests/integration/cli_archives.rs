@@ -3,36 +3,11 @@
 //! it cannot read.
 
 use std::io::Write;
-use std::path::Path;
 
-use crate::cli;
-use cli::eenf;
+use crate::cli::{ok_out_err as ok, refused, truth_hz as truth};
 
 use eenf::refdb::StoredGrid;
 use eenf::time::{parse_time, Zone};
-
-/// Runs `eenf ARGS`, which must succeed: its stdout and stderr.
-fn ok(args: &[&str], dir: &Path) -> (String, String) {
-    let out = eenf(args, dir);
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(out.status.success(), "eenf {args:?}: {err}");
-    (String::from_utf8_lossy(&out.stdout).into_owned(), err)
-}
-
-/// The one line an error prints.
-fn refused(args: &[&str], dir: &Path) -> String {
-    let out = eenf(args, dir);
-    let err = String::from_utf8_lossy(&out.stderr).trim().to_string();
-    assert!(!out.status.success(), "eenf {args:?} succeeded: {err}");
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(!err.contains("panicked"), "{err}");
-    err
-}
-
-/// A frequency that is a known function of the UTC time.
-fn truth(unix_s: f64) -> f64 {
-    50.0 + 0.03 * (unix_s / 700.0).sin() + 0.01 * (unix_s / 97.0).cos()
-}
 
 fn t(s: &str) -> f64 {
     parse_time(s).unwrap()

@@ -8,38 +8,40 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
-use crate::cli::eenf;
+use crate::cli::{ok_out_err as ok, refused, truth_hz as truth};
 use crate::replay::{query, Replay, Reply, Request};
 
 use eenf::refdb::StoredGrid;
 use eenf::time::{parse_time, utc};
 use sha2::Digest;
 
-/// A frequency that is a known function of the UTC time.
-fn truth(unix_s: f64) -> f64 {
-    50.0 + 0.03 * (unix_s / 700.0).sin() + 0.01 * (unix_s / 97.0).cos()
+/// `refdb fetch SOURCE --from FROM --to TO --store STORE --cache cache --endpoint ENDPOINT`.
+fn fetch_args<'a>(
+    source: &'a str,
+    from: &'a str,
+    to: &'a str,
+    store: &'a str,
+    endpoint: &'a str,
+) -> Vec<&'a str> {
+    vec![
+        "refdb",
+        "fetch",
+        source,
+        "--from",
+        from,
+        "--to",
+        to,
+        "--store",
+        store,
+        "--cache",
+        "cache",
+        "--endpoint",
+        endpoint,
+    ]
 }
 
 fn t(s: &str) -> f64 {
     parse_time(s).unwrap()
-}
-
-/// Runs `eenf ARGS`, which must succeed: its stdout and stderr.
-fn ok(args: &[&str], dir: &Path) -> (String, String) {
-    let out = eenf(args, dir);
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(out.status.success(), "eenf {args:?}: {err}");
-    (String::from_utf8_lossy(&out.stdout).into_owned(), err)
-}
-
-/// The one line an error prints.
-fn refused(args: &[&str], dir: &Path) -> String {
-    let out = eenf(args, dir);
-    let err = String::from_utf8_lossy(&out.stderr).trim().to_string();
-    assert!(!out.status.success(), "eenf {args:?} succeeded: {err}");
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(!err.contains("panicked"), "{err}");
-    err
 }
 
 /// A month's file as National Grid ESO publishes it (`dtm,f`, UTC, 1 s, three decimals):
@@ -195,21 +197,7 @@ fn gb_fetch_fills_the_store_refdb_build_makes_from_the_same_files_and_update_fet
     let gb = gb_server(false, false);
     let endpoint = gb_endpoint(&gb);
     let (out, err) = ok(
-        &[
-            "refdb",
-            "fetch",
-            "gb",
-            "--from",
-            "2023-01-01",
-            "--to",
-            "2023-02-28",
-            "--store",
-            "fetched",
-            "--cache",
-            "cache",
-            "--endpoint",
-            &endpoint,
-        ],
+        &fetch_args("gb", "2023-01-01", "2023-02-28", "fetched", &endpoint),
         d,
     );
     assert!(err.contains("downloaded"), "{err}");
@@ -377,21 +365,7 @@ fn every_failure_is_one_line_naming_the_source_and_leaves_the_store_as_it_was() 
     let endpoint = gb_endpoint(&gb);
     // a store with January in it
     ok(
-        &[
-            "refdb",
-            "fetch",
-            "gb",
-            "--from",
-            "2023-01-01",
-            "--to",
-            "2023-01-31",
-            "--store",
-            "s",
-            "--cache",
-            "cache",
-            "--endpoint",
-            &endpoint,
-        ],
+        &fetch_args("gb", "2023-01-01", "2023-01-31", "s", &endpoint),
         d,
     );
     let before = store_digest(&d.join("s"));
@@ -500,21 +474,13 @@ fn se_fetch_asks_an_hour_at_a_time_and_fills_the_store_refdb_build_makes_from_th
     });
     let endpoint = format!("{}/services/controlroom/v2/freq", se.base);
     ok(
-        &[
-            "refdb",
-            "fetch",
+        &fetch_args(
             "se",
-            "--from",
             "2023-05-01T10:30:00Z",
-            "--to",
             "2023-05-01T13:00:00Z",
-            "--store",
             "fetched",
-            "--cache",
-            "cache",
-            "--endpoint",
             &endpoint,
-        ],
+        ),
         d,
     );
     assert_eq!(se.requests().len(), 3, "{:?}", se.requests());
@@ -535,21 +501,13 @@ fn se_fetch_asks_an_hour_at_a_time_and_fills_the_store_refdb_build_makes_from_th
     // past hours are final: asked again, they come from the cache
     se.clear();
     ok(
-        &[
-            "refdb",
-            "fetch",
+        &fetch_args(
             "se",
-            "--from",
             "2023-05-01T10:30:00Z",
-            "--to",
             "2023-05-01T13:00:00Z",
-            "--store",
             "fetched",
-            "--cache",
-            "cache",
-            "--endpoint",
             &endpoint,
-        ],
+        ),
         d,
     );
     assert!(se.requests().is_empty(), "{:?}", se.requests());
