@@ -569,10 +569,10 @@ fn refdb_build(
 }
 
 /// `eenf refdb fetch`: fetches `start` to `end` (default now) of a grid operator's data
-/// (`gb`, `se`, `ch`, `osf`) into the store at `store`; returns what was fetched, as JSON
+/// (`gb`, `se`, `ch`, `osf`, `fi`) into the store at `store`; returns what was fetched, as JSON
 /// text. The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (source, store, start, end=None, endpoint=None, grid=None, cache=None, retries=3, wait=true))]
+#[pyo3(signature = (source, store, start, end=None, endpoint=None, grid=None, cache=None, retries=3, wait=true, api_key=None))]
 #[allow(clippy::too_many_arguments)]
 fn refdb_fetch(
     py: Python<'_>,
@@ -585,6 +585,7 @@ fn refdb_fetch(
     cache: Option<PathBuf>,
     retries: u32,
     wait: bool,
+    api_key: Option<String>,
 ) -> PyResult<String> {
     use eenf::fetch;
     let req = (|| -> eenf::Result<fetch::FetchRequest> {
@@ -601,6 +602,7 @@ fn refdb_fetch(
             grid,
             retries,
             wait,
+            api_key,
         })
     })()
     .map_err(py_err)?;
@@ -615,18 +617,26 @@ fn refdb_fetch(
 /// `eenf refdb update`: brings every fetched grid of the store at `store` up to now; returns
 /// what each source gave, as JSON text (a list). The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (store, cache=None, retries=3, wait=true))]
+#[pyo3(signature = (store, cache=None, retries=3, wait=true, api_key=None))]
 fn refdb_update(
     py: Python<'_>,
     store: PathBuf,
     cache: Option<PathBuf>,
     retries: u32,
     wait: bool,
+    api_key: Option<String>,
 ) -> PyResult<String> {
     use eenf::fetch;
     let cache = cache.unwrap_or_else(fetch::default_cache);
     py.detach(|| {
-        let done = fetch::update(&store, &cache, retries, wait, &Progress::hidden())?;
+        let done = fetch::update(
+            &store,
+            &cache,
+            retries,
+            wait,
+            api_key.as_deref(),
+            &Progress::hidden(),
+        )?;
         let list: Vec<_> = done.iter().map(|f| f.to_json()).collect();
         Ok(serde_json::Value::from(list).to_string())
     })

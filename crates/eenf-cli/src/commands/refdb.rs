@@ -22,7 +22,8 @@ pub enum Cmd {
     /// Fetch a span of a grid operator's frequency data into a store (created when missing):
     /// gb (National Grid ESO / NESO, monthly files, 1 s, UTC), se (Svenska kraftnät's control
     /// room, an hour per request, UTC), ch (Swissgrid, its last minutes only), osf (a file of
-    /// the OSF/WETI database, at the address given with --endpoint). Downloads are kept in a
+    /// the OSF/WETI database, at the address given with --endpoint), fi (Fingrid's open data
+    /// API, a free key). Downloads are kept in a
     /// cache and resumed when cut; the store changes only when all are in.
     Fetch(FetchArgs),
     /// Bring every fetched grid of a store up to now, from the sources its manifest records.
@@ -57,7 +58,7 @@ pub struct BuildArgs {
 /// Arguments of `eenf refdb fetch`.
 #[derive(Debug, clap::Args)]
 pub struct FetchArgs {
-    /// The source: gb, se, ch or osf.
+    /// The source: gb, se, ch, osf or fi.
     #[arg(value_parser = source_name)]
     pub source: Source,
     /// Start: a day (2024-06-01, from its start in UTC) or a time with its zone.
@@ -73,7 +74,7 @@ pub struct FetchArgs {
     /// operator's format).
     #[arg(long)]
     pub endpoint: Option<String>,
-    /// The grid's name in the store (default: the source's: gb, se, ch, ce).
+    /// The grid's name in the store (default: the source's: gb, se, ch, ce, fi).
     #[arg(long)]
     pub grid: Option<String>,
     #[command(flatten)]
@@ -101,6 +102,10 @@ pub struct DownloadArgs {
     /// Fail at once when another build is changing the store, instead of waiting for it.
     #[arg(long)]
     pub no_wait: bool,
+    /// The API key of a source that needs one (fi: Fingrid's, free from data.fingrid.fi; else
+    /// the environment variable FINGRID_API_KEY). It is sent, never stored.
+    #[arg(long)]
+    pub api_key: Option<String>,
 }
 
 impl DownloadArgs {
@@ -164,6 +169,7 @@ fn fetch_into(a: FetchArgs, progress: Progress) -> Result<()> {
         grid: a.grid.clone(),
         retries: a.download.retries,
         wait: !a.download.no_wait,
+        api_key: a.download.api_key.clone(),
     };
     let fetched = fetch::fetch(&req, &progress)?;
     report_fetch(&fetched, &a.store);
@@ -176,6 +182,7 @@ fn update(a: UpdateArgs, progress: Progress) -> Result<()> {
         &a.download.cache(),
         a.download.retries,
         !a.download.no_wait,
+        a.download.api_key.as_deref(),
         &progress,
     )?;
     if done.is_empty() {

@@ -589,3 +589,81 @@ fn ch_times_are_read_in_the_zone_the_time_of_retrieval_shows() {
         );
     }
 }
+
+/// Fingrid's answer for `[a, b)`: 1 s values, in pages of 2,000 rows (the server's choice, as
+/// the API caps a page), with the API's `pagination`.
+fn fingrid_answer(a: f64, b: f64, page: usize) -> Vec<u8> {
+    let rows: Vec<f64> = (0..(b - a) as usize).map(|k| a + k as f64).collect();
+    let per = 2000;
+    let pages = rows.len().div_ceil(per).max(1);
+    let data: Vec<serde_json::Value> = rows
+        .iter()
+        .skip((page - 1) * per)
+        .take(per)
+        .map(|&u| {
+            serde_json::json!({"datasetId": 177, "startTime": utc(u).replace('Z', ".000Z"),
+                "endTime": utc(u + 1.0).replace('Z', ".000Z"), "value": (truth(u) * 1000.0).round() / 1000.0})
+        })
+        .collect();
+    serde_json::json!({"data": data, "pagination": {"total": rows.len(), "lastPage": pages,
+        "prevPage": if page > 1 { Some(page - 1) } else { None },
+        "nextPage": if page < pages { Some(page + 1) } else { None },
+        "perPage": per, "currentPage": page, "from": (page - 1) * per + 1, "to": (page * per).min(rows.len())}})
+    .to_string()
+    .into_bytes()
+}
+
+#[test]
+fn fi_fetch_sends_its_key_follows_the_pages_and_fills_the_store_refdb_build_makes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let fi = Replay::start(|r: &Request| {
+        if r.api_key.as_deref() != Some("k3y") {
+            return Reply::status(401);
+        }
+        let (Some(a), Some(b), Some(p)) = (
+            query(&r.target, "startTime"),
+            query(&r.target, "endTime"),
+            query(&r.target, "page"),
+        ) else {
+            return Reply::status(400);
+        };
+        Reply::ok(fingrid_answer(t(&a), t(&b), p.parse().unwrap()))
+    });
+    let endpoint = format!("{}/api/datasets/177/data", fi.base);
+    let mut args = fetch_args(
+        "fi",
+        "2023-06-01T00:00:00Z",
+        "2023-06-01T01:00:00Z",
+        "fetched",
+        &endpoint,
+    );
+    // no key: one line, before any request
+    let err = refused(&args, d);
+    assert!(err.contains("fi:") && err.contains("--api-key"), "{err}");
+    assert!(fi.requests().is_empty());
+    // a wrong key: the server's 401, named
+    args.extend(["--api-key", "wrong", "--retries", "0"]);
+    let err = refused(&args, d);
+    assert!(err.contains("401") && err.contains("API key"), "{err}");
+    fi.clear();
+    let n = args.len();
+    args[n - 3] = "k3y";
+    ok(&args, d);
+    let requests = fi.requests();
+    assert_eq!(requests.len(), 2, "{requests:?}");
+    assert!(requests[1].contains("page=2"), "{requests:?}");
+    let cached = files_in(&d.join("cache/fi"));
+    let mut build = vec!["refdb", "build", "built", "--grid", "fi"];
+    build.extend(cached.iter().map(String::as_str));
+    ok(&build, d);
+    let a = StoredGrid::load(&d.join("fetched"), "fi").unwrap();
+    let b = StoredGrid::load(&d.join("built"), "fi").unwrap();
+    assert_eq!(a.values, b.values);
+    assert_eq!(a.meta.count, 3600);
+    let at = t("2023-06-01T00:45:00Z");
+    assert!((a.hz()[2700] - truth(at)).abs() < 0.0006);
+    // the key is sent, never stored
+    let manifest = std::fs::read_to_string(d.join("fetched/fi.json")).unwrap();
+    assert!(!manifest.contains("k3y"));
+}

@@ -54,10 +54,12 @@ impl Reply {
     }
 }
 
-/// A request as the handler sees it: its path with the query, and where a `Range` starts.
+/// A request as the handler sees it: its path with the query, where a `Range` starts, and
+/// the `x-api-key` it sent.
 pub struct Request {
     pub target: String,
     pub range_from: Option<u64>,
+    pub api_key: Option<String>,
 }
 
 type Handler = dyn Fn(&Request) -> Reply + Send + Sync;
@@ -88,12 +90,16 @@ impl Replay {
                 }
                 let target = first.split_whitespace().nth(1).unwrap_or("/").to_string();
                 let mut range_from = None;
+                let mut api_key = None;
                 loop {
                     let mut line = String::new();
                     if reader.read_line(&mut line).unwrap_or(0) == 0 || line.trim().is_empty() {
                         break;
                     }
                     let lower = line.to_ascii_lowercase();
+                    if lower.starts_with("x-api-key:") {
+                        api_key = Some(line["x-api-key:".len()..].trim().to_string());
+                    }
                     if let Some(r) = lower.strip_prefix("range:") {
                         range_from = r
                             .trim()
@@ -106,7 +112,11 @@ impl Replay {
                     Some(n) => format!("{target} range={n}"),
                     None => target.clone(),
                 });
-                let reply = handler(&Request { target, range_from });
+                let reply = handler(&Request {
+                    target,
+                    range_from,
+                    api_key,
+                });
                 let mut head = format!(
                     "HTTP/1.1 {} X\r\nContent-Length: {}\r\nConnection: close\r\n",
                     reply.status,

@@ -558,12 +558,14 @@ def refdb_fetch(
     cache: Optional[PathLike] = None,
     retries: int = 3,
     wait: bool = True,
+    api_key: Optional[str] = None,
 ) -> Dict[str, Any]:
     """``eenf refdb fetch``: fetches ``start`` to ``end`` (a day such as ``"2023-01-01"``, or a
     time with its zone; ``end`` defaults to now) of a grid operator's frequency data into the
     store ``store``: ``"gb"`` (National Grid ESO / NESO monthly files), ``"se"`` (Svenska
-    kraftnät's control room), ``"ch"`` (Swissgrid, its last minutes only) or ``"osf"`` (an OSF
-    database file at ``endpoint``). ``endpoint`` asks a mirror instead of the operator.
+    kraftnät's control room), ``"ch"`` (Swissgrid, its last minutes only), ``"osf"`` (an OSF
+    database file at ``endpoint``) or ``"fi"`` (Fingrid's open data API: ``api_key``, else the
+    environment variable ``FINGRID_API_KEY``). ``endpoint`` asks a mirror instead of the operator.
     Downloads are kept in ``cache`` (default ``~/.cache/eenf/fetch``) and resumed when cut;
     the store changes only when all are in, with each file's address, time of retrieval and
     SHA-256 in its manifest. Returns the ``files`` (``url``, ``path``, ``cached``), the
@@ -579,19 +581,25 @@ def refdb_fetch(
             None if cache is None else os.fspath(cache),
             retries,
             wait,
+            api_key,
         )
     )
 
 
 def refdb_update(
-    store: PathLike, *, cache: Optional[PathLike] = None, retries: int = 3, wait: bool = True
+    store: PathLike,
+    *,
+    cache: Optional[PathLike] = None,
+    retries: int = 3,
+    wait: bool = True,
+    api_key: Optional[str] = None,
 ) -> List[Dict[str, Any]]:
     """``eenf refdb update``: brings every fetched grid of ``store`` up to now, asking each
     source its manifest records for what lies after the grid's last value. Returns what each
     source gave, as :func:`refdb_fetch` does."""
     return json.loads(
         _eenf.refdb_update(
-            os.fspath(store), None if cache is None else os.fspath(cache), retries, wait
+            os.fspath(store), None if cache is None else os.fspath(cache), retries, wait, api_key
         )
     )
 

@@ -216,7 +216,7 @@ def refdb_build(
     index_step: Optional[float] = None,
 ) -> Dict[str, Any]: ...
 def refdb_fetch(
-    source: Literal["gb", "se", "ch", "osf"],
+    source: Literal["gb", "se", "ch", "osf", "fi"],
     store: PathLike,
     start: str,
     end: Optional[str] = None,
@@ -226,9 +226,15 @@ def refdb_fetch(
     cache: Optional[PathLike] = None,
     retries: int = 3,
     wait: bool = True,
+    api_key: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def refdb_update(
-    store: PathLike, *, cache: Optional[PathLike] = None, retries: int = 3, wait: bool = True
+    store: PathLike,
+    *,
+    cache: Optional[PathLike] = None,
+    retries: int = 3,
+    wait: bool = True,
+    api_key: Optional[str] = None,
 ) -> List[Dict[str, Any]]: ...
 def simulate(
     output: Optional[PathLike] = None,

@@ -29,6 +29,8 @@ pub(super) struct Http {
     /// Least time between two requests.
     pause: Duration,
     last: Option<Instant>,
+    /// A header sent with every request (an API key).
+    header: Option<(&'static str, String)>,
 }
 
 /// Why one attempt failed, and whether another may succeed.
@@ -56,7 +58,14 @@ impl Http {
             retries,
             pause,
             last: None,
+            header: None,
         }
+    }
+
+    /// Sends `value` as header `name` with every request.
+    pub(super) fn with_header(mut self, name: &'static str, value: String) -> Self {
+        self.header = Some((name, value));
+        self
     }
 
     fn wait_turn(&mut self) {
@@ -106,6 +115,9 @@ impl Http {
         range_from: u64,
     ) -> Result<ureq::http::Response<ureq::Body>, Attempt> {
         let mut req = self.agent.get(url);
+        if let Some((name, value)) = &self.header {
+            req = req.header(*name, value);
+        }
         if range_from > 0 {
             req = req.header("Range", format!("bytes={range_from}-"));
         }

@@ -47,6 +47,8 @@ pub struct FetchRequest {
     pub retries: u32,
     /// Wait for another build that holds the store (else fail at once).
     pub wait: bool,
+    /// The API key of a source that needs one (Fingrid); never recorded in the store.
+    pub api_key: Option<String>,
 }
 
 /// One file a fetch used.
@@ -120,6 +122,9 @@ pub fn default_cache() -> PathBuf {
     base.join("eenf").join("fetch")
 }
 
+/// The environment variable that holds a Fingrid API key when `--api-key` is not given.
+pub const FINGRID_KEY_VAR: &str = "FINGRID_API_KEY";
+
 /// Now, Unix seconds.
 fn now_s() -> f64 {
     std::time::SystemTime::now()
@@ -178,6 +183,20 @@ fn fetch_published(
     crate::refdb::check_grid_name(&grid)?;
     let cache = req.cache.join(name);
     let mut http = Http::new(name, req.retries, Duration::from_secs_f64(source.pause_s()));
+    if source == Source::Fi {
+        let key = req
+            .api_key
+            .clone()
+            .or_else(|| std::env::var(FINGRID_KEY_VAR).ok())
+            .filter(|k| !k.trim().is_empty());
+        let Some(key) = key else {
+            fail!(
+                Fetch,
+                "fi: Fingrid's API needs a free key (data.fingrid.fi): give it with --api-key or {FINGRID_KEY_VAR}"
+            );
+        };
+        http = http.with_header("x-api-key", key.trim().to_string());
+    }
     let mut notes = Vec::new();
     let mut zone = None;
     let plan = match source {
@@ -199,6 +218,7 @@ fn fetch_published(
             path: cache.join(format!("{}.json", (now * 1000.0) as i64)),
             reuse: false,
         }],
+        Source::Fi => sources::fi_plan(&endpoint, req.from_unix_s, to, now, &cache),
         Source::Osf => vec![Download {
             url: endpoint.clone(),
             path: cache.join(format!(
@@ -219,10 +239,16 @@ fn fetch_published(
         endpoint: endpoint.clone(),
         files: Vec::new(),
     };
-    for d in &plan {
+    let mut queue: std::collections::VecDeque<Download> = plan.iter().cloned().collect();
+    while let Some(d) = queue.pop_front() {
         let cached = d.reuse && d.path.is_file();
         if !cached {
             http.download(&d.url, &d.path)?;
+        }
+        if source == Source::Fi {
+            if let Some(next) = sources::fi_next_page(&d, &endpoint, &cache)? {
+                queue.push_front(next);
+            }
         }
         let (sha256, bytes) = http::sha256_of(&d.path)?;
         let retrieved = std::fs::metadata(&d.path)
@@ -242,7 +268,9 @@ fn fetch_published(
             path: d.path.clone(),
             cached,
         });
-        bar.inc(1);
+        if !d.url.contains("page=") || d.url.contains("page=1&") {
+            bar.inc(1);
+        }
     }
     bar.finish_and_clear();
     if source == Source::Ch {
@@ -355,6 +383,7 @@ pub fn update(
     cache: &Path,
     retries: u32,
     wait: bool,
+    api_key: Option<&str>,
     progress: &Progress,
 ) -> Result<Vec<Fetched>> {
     let mut done = Vec::new();
@@ -382,6 +411,7 @@ pub fn update(
                 grid: Some(grid.clone()),
                 retries,
                 wait,
+                api_key: api_key.map(str::to_string),
             };
             if req.from_unix_s >= req.to_unix_s - 1.0 || source == Source::Osf {
                 continue; // up to date, or a fixed file

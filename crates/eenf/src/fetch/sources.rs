@@ -21,11 +21,14 @@ pub enum Source {
     /// Continental Europe: a file of the OSF power grid frequency database (WETI), at the
     /// address given with `--endpoint`.
     Osf,
+    /// Finland (Nordic grid): Fingrid's open data API, a data set's values a day per request
+    /// (pages of 20,000 rows), with a free API key.
+    Fi,
 }
 
 impl Source {
     /// Names `refdb fetch` takes.
-    pub const NAMES: [&'static str; 4] = ["gb", "se", "ch", "osf"];
+    pub const NAMES: [&'static str; 5] = ["gb", "se", "ch", "osf", "fi"];
 
     /// Its name.
     pub fn name(self) -> &'static str {
@@ -34,7 +37,7 @@ impl Source {
 
     /// The source of a name.
     pub fn from_name(s: &str) -> Option<Source> {
-        [Source::Gb, Source::Se, Source::Ch, Source::Osf]
+        [Source::Gb, Source::Se, Source::Ch, Source::Osf, Source::Fi]
             .into_iter()
             .find(|x| x.name().eq_ignore_ascii_case(s))
     }
@@ -46,6 +49,7 @@ impl Source {
             Source::Se => "Svenska kraftnät control-room frequency (Nordic grid, UTC)",
             Source::Ch => "Swissgrid current frequency (Continental Europe, last minutes only)",
             Source::Osf => "OSF power grid frequency database file (Continental Europe, UTC)",
+            Source::Fi => "Fingrid open data API (Nordic grid, UTC)",
         }
     }
 
@@ -60,6 +64,8 @@ impl Source {
                 "https://www.swissgrid.ch/content/swissgrid/en/home/operation/regulation/frequency.apicache.html?path=/content/swissgrid/en/home/operation/regulation/frequency/jcr:content/parsys/chart_copy",
             ),
             Source::Osf => None,
+            // data set 177: "Frequency - real time data"
+            Source::Fi => Some("https://data.fingrid.fi/api/datasets/177/data"),
         }
     }
 
@@ -70,6 +76,7 @@ impl Source {
             Source::Se => "se",
             Source::Ch => "ch",
             Source::Osf => "ce",
+            Source::Fi => "fi",
         }
     }
 
@@ -80,6 +87,8 @@ impl Source {
             Source::Gb | Source::Osf => 0.5,
             Source::Se => 0.5,
             Source::Ch => 0.0,
+            // Fingrid allows 10 requests a minute per key
+            Source::Fi => 6.0,
         }
     }
 
@@ -88,7 +97,7 @@ impl Source {
         match self {
             Source::Gb => ArchiveFormat::Ngeso,
             Source::Osf => ArchiveFormat::Osf,
-            Source::Se | Source::Ch => ArchiveFormat::Auto,
+            Source::Se | Source::Ch | Source::Fi => ArchiveFormat::Auto,
         }
     }
 }
@@ -287,6 +296,91 @@ pub(super) fn se_plan(endpoint: &str, from: f64, to: f64, now: f64, cache: &Path
         h += 1;
     }
     plan
+}
+
+/// Rows per Fingrid page (the API's largest).
+const FI_PAGE_ROWS: u32 = 20_000;
+
+/// The first page of each UTC day that overlaps `[from, to)` from Fingrid's API; the pages
+/// after it come from each answer's `pagination` ([`fi_next_page`]).
+pub(super) fn fi_plan(endpoint: &str, from: f64, to: f64, now: f64, cache: &Path) -> Vec<Download> {
+    let mut plan = Vec::new();
+    let to = to.min(now);
+    let mut day = (from / 86_400.0).floor() as i64;
+    while (day as f64) * 86_400.0 < to {
+        let a = (day * 86_400) as f64;
+        let b = (a + 86_400.0).min(to.ceil());
+        // the last hour's values may still be coming: a day that reaches it is asked again
+        plan.push(fi_page(
+            endpoint,
+            a.max(from.floor()),
+            b,
+            1,
+            b > now - 3600.0,
+            cache,
+        ));
+        day += 1;
+    }
+    plan
+}
+
+fn fi_page(endpoint: &str, a: f64, b: f64, page: u32, open: bool, cache: &Path) -> Download {
+    let query = format!(
+        "startTime={}&endTime={}&format=json&pageSize={FI_PAGE_ROWS}&page={page}&sortBy=startTime&sortOrder=asc",
+        utc(a),
+        utc(b)
+    );
+    let url = with_query(endpoint, &query);
+    let name = format!(
+        "{}-p{page}-{}{}.json",
+        &utc(a)[..10],
+        tag(&url),
+        if open { "-partial" } else { "" }
+    );
+    Download {
+        url,
+        path: cache.join(name),
+        reuse: !open,
+    }
+}
+
+/// The page after `d` when the answer at `d.path` says there is one (`pagination.nextPage`).
+pub(super) fn fi_next_page(d: &Download, endpoint: &str, cache: &Path) -> Result<Option<Download>> {
+    let text = std::fs::read(&d.path)
+        .map_err(|e| crate::error::Error::Fetch(format!("fi: {}: {e}", d.path.display())))?;
+    let v: serde_json::Value = serde_json::from_slice(&text).map_err(|_| {
+        crate::error::Error::Fetch(format!(
+            "fi: {}: not JSON (expected Fingrid's {{\"data\": [...], \"pagination\": {{...}}}})",
+            d.url
+        ))
+    })?;
+    if !v.get("data").is_some_and(|x| x.is_array()) {
+        fail!(
+            Fetch,
+            "fi: {}: no data list (expected Fingrid's {{\"data\": [{{startTime, value}}], \"pagination\"}}): the format may have changed",
+            d.url
+        );
+    }
+    let Some(next) = v.pointer("/pagination/nextPage").and_then(|n| n.as_u64()) else {
+        return Ok(None);
+    };
+    let query = |k: &str| {
+        d.url
+            .split(['?', '&'])
+            .find_map(|kv| kv.strip_prefix(&format!("{k}=")))
+            .and_then(|t| crate::time::parse_time(t).ok())
+    };
+    let (Some(a), Some(b)) = (query("startTime"), query("endTime")) else {
+        return Ok(None);
+    };
+    if next > 100_000 {
+        fail!(
+            Fetch,
+            "fi: {}: names page {next} next: not a page of one day",
+            d.url
+        );
+    }
+    Ok(Some(fi_page(endpoint, a, b, next as u32, !d.reuse, cache)))
 }
 
 /// The zone Swissgrid's chart times are in, told from the time of retrieval: its latest
