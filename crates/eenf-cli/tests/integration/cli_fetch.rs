@@ -116,7 +116,8 @@ fn gb_server(cut_once: bool, cut_always: bool) -> Gb {
                     serde_json::json!({
                         // libhum reads both dashes; NESO has used both
                         "name": format!("{}_2023_{}_historic_frequency_data", MONTH_NAMES[m as usize - 1], if m == 2 { "–" } else { "-" }),
-                        "path": format!("{base}/files/f-2023-{m}.{}", if zip { "zip" } else { "csv" }),
+                        // March's address is relative to the index's host, as a mirror may write it
+                        "path": format!("{}/files/f-2023-{m}.{}", if m == 3 { "" } else { &base }, if zip { "zip" } else { "csv" }),
                         "format": if zip { "ZIP" } else { "CSV" },
                     })
                 })
@@ -511,6 +512,32 @@ fn se_fetch_asks_an_hour_at_a_time_and_fills_the_store_refdb_build_makes_from_th
         d,
     );
     assert!(se.requests().is_empty(), "{:?}", se.requests());
+    // an address written as libhum's template asks the same hours
+    let template = format!("{endpoint}?fromDateTime={{from_dt}}&toDateTime={{to_dt}}");
+    ok(
+        &[
+            "refdb",
+            "fetch",
+            "se",
+            "--from",
+            "2023-05-01T13:00:00Z",
+            "--to",
+            "2023-05-01T14:00:00Z",
+            "--store",
+            "fetched",
+            "--cache",
+            "cache2",
+            "--endpoint",
+            &template,
+        ],
+        d,
+    );
+    let r = se.requests();
+    assert_eq!(r.len(), 1, "{r:?}");
+    assert!(
+        r[0].ends_with("fromDateTime=1682946000000&toDateTime=1682949600000"),
+        "{r:?}"
+    );
 }
 
 /// Swissgrid's chart answer: the last ten minutes at 1 s, its times encoded as `offset_s`

@@ -124,6 +124,29 @@ fn with_query(url: &str, query: &str) -> String {
     format!("{url}{sep}{query}")
 }
 
+/// An index's file address as an absolute URL: as given when it has a scheme, else resolved
+/// against the index's address (`/files/x.csv` from its host, `x.csv` beside it).
+fn absolute(path: &str, index: &str) -> String {
+    if path.contains("://") {
+        return path.to_string();
+    }
+    let base = index.split(['?', '#']).next().unwrap_or(index);
+    let host_end = base
+        .find("://")
+        .map(|i| i + 3)
+        .and_then(|i| base[i..].find('/').map(|j| i + j))
+        .unwrap_or(base.len());
+    if path.starts_with('/') {
+        format!("{}{path}", &base[..host_end])
+    } else {
+        let dir = base
+            .rfind('/')
+            .filter(|&i| i >= host_end)
+            .unwrap_or(base.len());
+        format!("{}/{path}", &base[..dir])
+    }
+}
+
 const MONTHS: [&str; 12] = [
     "january",
     "february",
@@ -211,7 +234,12 @@ pub(super) fn gb_plan(
             .join(" ")
             .to_ascii_lowercase();
         let zip = kind.contains("zip") || url.to_ascii_lowercase().ends_with(".zip");
-        months.push((y, m, url.to_string(), if zip { "zip" } else { "csv" }));
+        months.push((
+            y,
+            m,
+            absolute(url, endpoint),
+            if zip { "zip" } else { "csv" },
+        ));
     }
     if months.is_empty() {
         fail!(
@@ -276,10 +304,17 @@ pub(super) fn se_plan(endpoint: &str, from: f64, to: f64, now: f64, cache: &Path
         let start_ms = h * 3_600_000;
         let end_ms = (((h + 1) * 3600) as f64).min(to) as i64 * 1000;
         let done = end_ms == (h + 1) * 3_600_000 && ((h + 1) * 3600) as f64 <= now - 60.0;
-        let url = with_query(
-            endpoint,
-            &format!("fromDateTime={start_ms}&toDateTime={end_ms}"),
-        );
+        // an address may carry the query as libhum's template does; else it is appended
+        let url = if endpoint.contains("{from_dt}") {
+            endpoint
+                .replace("{from_dt}", &start_ms.to_string())
+                .replace("{to_dt}", &end_ms.to_string())
+        } else {
+            with_query(
+                endpoint,
+                &format!("fromDateTime={start_ms}&toDateTime={end_ms}"),
+            )
+        };
         let stamp = jiff::Timestamp::from_second(h * 3600)
             .map(|t| t.strftime("%Y-%m-%dT%H").to_string())
             .unwrap_or_else(|_| h.to_string());
