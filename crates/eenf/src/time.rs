@@ -274,6 +274,22 @@ pub fn parse_time(s: &str) -> Result<f64> {
     Ok(ts.as_second() as f64 + ts.subsec_nanosecond() as f64 * 1e-9)
 }
 
+/// A day (`2024-06-01`: its start in UTC, or with `end_of_day` its end) or a time with its
+/// zone ([`parse_time`]), Unix seconds.
+pub fn parse_day_or_time(s: &str, end_of_day: bool) -> Result<f64> {
+    let day = s.trim();
+    let is_day = day.len() == 10 && day.as_bytes()[4] == b'-' && day.as_bytes()[7] == b'-';
+    if let Some(d) = is_day
+        .then(|| day.parse::<jiff::civil::Date>().ok())
+        .flatten()
+    {
+        let start =
+            days_from_civil(d.year() as i64, d.month() as u32, d.day() as u32) as f64 * 86_400.0;
+        return Ok(if end_of_day { start + 86_400.0 } else { start });
+    }
+    parse_time(s)
+}
+
 /// `Z`, `UTC`, `+08:00`, `-0500`, `+8` → seconds east of UTC.
 pub fn tz_offset(tz: &str) -> Result<f64> {
     if tz.is_empty() || tz == "Z" || tz.eq_ignore_ascii_case("utc") {

@@ -115,8 +115,7 @@ impl DownloadArgs {
 }
 
 fn source_name(s: &str) -> Result<Source, String> {
-    Source::from_name(s)
-        .ok_or_else(|| format!("{s:?}: expected one of {}", Source::NAMES.join(", ")))
+    Source::parse(s).map_err(|e| e.to_string())
 }
 
 fn report_fetch(f: &fetch::Fetched, store: &Path) {

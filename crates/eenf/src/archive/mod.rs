@@ -38,7 +38,7 @@ mod state;
 
 pub use dates::parse_date_time;
 pub use layout::{sniff, Layout, TimeColumns, ZoneRule};
-pub use operator_json::OperatorJson;
+pub use operator_json::{swissgrid_span, OperatorJson};
 
 use container::{container_of, first_lines, for_each_member, read_line, Container};
 use state::{ClockNote, ImportState};

@@ -180,11 +180,21 @@ fn number(v: &serde_json::Value) -> Option<f64> {
         .filter(|x: &f64| x.is_finite())
 }
 
-/// Milliseconds after 1970-01-01 00:00 as the clock `YYYY-MM-DD HH:MM:SS.fff`, no zone.
+/// Milliseconds after 1970-01-01 00:00 as the clock `YYYY-MM-DDTHH:MM:SS.ffffff`, no zone.
 fn clock(ms: f64) -> Option<String> {
-    if !ms.is_finite() {
+    // the calendar's years (-9999 to 9999), as before; the importer drops rows outside its own
+    if !ms.is_finite() || ms.abs() > 2.5e14 {
         return None;
     }
-    let ts = jiff::Timestamp::from_millisecond(ms.round() as i64).ok()?;
-    Some(ts.strftime("%Y-%m-%d %H:%M:%S%.3f").to_string())
+    let text = crate::time::utc_micros((ms * 1000.0).round() as i64);
+    Some(text.trim_end_matches('Z').to_string())
+}
+
+/// The first and last time (ms, as written) of a Swissgrid chart answer, `None` when it holds
+/// no points.
+pub fn swissgrid_span(path: &Path) -> Option<(f64, f64)> {
+    let v = read_value(path).ok()?;
+    let rows = v.pointer("/data/series/0/data")?.as_array()?;
+    let time = |r: &serde_json::Value| r.get(0).and_then(|t| t.as_f64());
+    Some((time(rows.first()?)?, time(rows.last()?)?))
 }

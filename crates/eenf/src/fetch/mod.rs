@@ -9,6 +9,7 @@
 mod http;
 mod sources;
 
+pub use crate::time::parse_day_or_time;
 pub use sources::Source;
 
 use std::path::{Path, PathBuf};
@@ -17,7 +18,7 @@ use std::time::Duration;
 use eenf_core::Grid;
 
 use crate::archive::{ArchiveOptions, ValueUnit};
-use crate::error::{error, fail, Context, Result};
+use crate::error::{error, fail, Result};
 use crate::progress::Progress;
 use crate::refdb::{FetchedFile, FetchedFrom, StoredGrid};
 use crate::reference::{build_store, StoreBuild, StoreBuilt};
@@ -239,15 +240,17 @@ fn fetch_published(
         endpoint: endpoint.clone(),
         files: Vec::new(),
     };
-    let mut queue: std::collections::VecDeque<Download> = plan.iter().cloned().collect();
-    while let Some(d) = queue.pop_front() {
+    // (a download, whether the plan named it: the pages after a first page are found on the way)
+    let mut queue: std::collections::VecDeque<(Download, bool)> =
+        plan.iter().map(|d| (d.clone(), true)).collect();
+    while let Some((d, planned)) = queue.pop_front() {
         let cached = d.reuse && d.path.is_file();
         if !cached {
             http.download(&d.url, &d.path)?;
         }
         if source == Source::Fi {
             if let Some(next) = sources::fi_next_page(&d, &endpoint, &cache)? {
-                queue.push_front(next);
+                queue.push_front((next, false));
             }
         }
         let (sha256, bytes) = http::sha256_of(&d.path)?;
@@ -268,14 +271,20 @@ fn fetch_published(
             path: d.path.clone(),
             cached,
         });
-        if !d.url.contains("page=") || d.url.contains("page=1&") {
+        if planned {
             bar.inc(1);
         }
     }
     bar.finish_and_clear();
     if source == Source::Ch {
         let path = &plan[0].path;
-        let (first, last) = ch_span(path)?;
+        let Some((first, last)) = crate::archive::swissgrid_span(path) else {
+            fail!(
+                Fetch,
+                "ch: {}: no data.series[0].data points (expected [[ms, Hz], …]): the format may have changed",
+                path.display()
+            );
+        };
         zone = Some(sources::ch_zone(last, now)?);
         let z = zone.as_ref().map(|z| z.name()).unwrap_or_default();
         notes.push(format!(
@@ -323,35 +332,6 @@ fn fetch_published(
         built,
         notes,
     }))
-}
-
-/// The first and last time (ms) of a Swissgrid chart answer.
-fn ch_span(path: &Path) -> Result<(f64, f64)> {
-    let text = std::fs::read(path).with_context(|| format!("{}", path.display()))?;
-    let v: serde_json::Value = serde_json::from_slice(&text).map_err(|_| {
-        error!(
-            Fetch,
-            "ch: {}: not JSON (expected data.series[0].data)",
-            path.display()
-        )
-    })?;
-    let times: Vec<f64> = v
-        .pointer("/data/series/0/data")
-        .and_then(|d| d.as_array())
-        .map(|rows| {
-            rows.iter()
-                .filter_map(|r| r.get(0).and_then(|t| t.as_f64()))
-                .collect()
-        })
-        .unwrap_or_default();
-    match (times.first(), times.last()) {
-        (Some(a), Some(b)) => Ok((*a, *b)),
-        _ => fail!(
-            Fetch,
-            "ch: {}: no data.series[0].data points (expected [[ms, Hz], …]): the format may have changed",
-            path.display()
-        ),
-    }
 }
 
 /// A file name from an address's last path segment (plain characters only).
@@ -429,19 +409,4 @@ pub fn update(
         );
     }
     Ok(done)
-}
-
-/// A day (`2024-06-01`, its start in UTC) or a time with its zone, Unix seconds; with
-/// `end_of_day`, a day means its end.
-pub fn parse_day_or_time(s: &str, end_of_day: bool) -> Result<f64> {
-    let day = s.trim();
-    let is_day = day.len() == 10 && day.as_bytes()[4] == b'-' && day.as_bytes()[7] == b'-';
-    if let Some(d) = is_day
-        .then(|| day.parse::<jiff::civil::Date>().ok())
-        .flatten()
-    {
-        let start = d.to_zoned(jiff::tz::TimeZone::UTC)?.timestamp().as_second() as f64;
-        return Ok(if end_of_day { start + 86_400.0 } else { start });
-    }
-    crate::time::parse_time(s)
 }

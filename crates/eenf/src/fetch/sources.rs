@@ -289,9 +289,8 @@ pub(super) fn gb_plan(
 
 /// The year and month of a Unix time (UTC).
 fn civil_month(t: f64) -> (i64, u32) {
-    let ts = jiff::Timestamp::from_second(t.floor() as i64).unwrap_or(jiff::Timestamp::UNIX_EPOCH);
-    let d = ts.to_zoned(jiff::tz::TimeZone::UTC).date();
-    (d.year() as i64, d.month() as u32)
+    let day = crate::time::LocalTime::from_local_seconds(t.floor() as i64);
+    (day.year() as i64, day.month() as u32)
 }
 
 /// The Swedish hours that overlap `[from, to)`, one request each (the control room gives at
@@ -315,9 +314,7 @@ pub(super) fn se_plan(endpoint: &str, from: f64, to: f64, now: f64, cache: &Path
                 &format!("fromDateTime={start_ms}&toDateTime={end_ms}"),
             )
         };
-        let stamp = jiff::Timestamp::from_second(h * 3600)
-            .map(|t| t.strftime("%Y-%m-%dT%H").to_string())
-            .unwrap_or_else(|_| h.to_string());
+        let stamp = utc((h * 3600) as f64)[..13].to_string();
         let name = if done {
             format!("{stamp}-{}.json", tag(&url))
         } else {
