@@ -90,12 +90,35 @@ def audio(minutes_list):
         print(f"| {minutes:g} min | {wall:.1f} | {mb:.0f} | {cc:.4f} | {mae:.2f} |", flush=True)
 
 
+def part_entry(file, first, b):
+    """A part's entry in the manifest, from its bytes: its CRC-32, values that are not gaps
+    and their sum (what refdb writes)."""
+    v = np.frombuffer(b, dtype="<i4").astype(np.int64)
+    v = v[v != -2**31]
+    return {"file": file, "first": first, "count": len(b) // 4, "crc32": zlib.crc32(b),
+            "finite": int(len(v)), "sum_uhz": int(v.sum())}
+
+
+def with_sums(d, manifest):
+    """Gives the parts of a store written before parts carried their sums those sums."""
+    meta = json.load(open(manifest))
+    if all("sum_uhz" in p for p in meta["parts"]):
+        return
+    meta["parts"] = [part_entry(p["file"], p["first"], open(os.path.join(d, p["file"]), "rb").read())
+                     for p in meta["parts"]]
+    with open(manifest + ".part", "w") as f:
+        json.dump(meta, f)
+    os.replace(manifest + ".part", manifest)
+
+
 def store(name, years, seed):
     """A store folder holding one grid `name` over `years` at 1 s; its folder. Written in the
-    store's layout: parts of 2^22 values counted from the Unix epoch, each with its CRC-32."""
+    store's layout: parts of 2^22 values counted from the Unix epoch, each with its CRC-32 and
+    sums."""
     d = os.path.join(out, f"store-{name}-{years:g}y")
     manifest = os.path.join(d, f"{name}.json")
     if os.path.exists(manifest):
+        with_sums(d, manifest)
         return d
     os.makedirs(d, exist_ok=True)
     count = int(years * 365.25 * 86400)
@@ -116,7 +139,7 @@ def store(name, years, seed):
         file = f"{name}.bench{len(parts):05d}.0.i32"
         with open(os.path.join(d, file), "wb") as f:
             f.write(b)
-        parts.append({"file": file, "first": lo, "count": n, "crc32": zlib.crc32(b)})
+        parts.append(part_entry(file, lo, b))
         lo += n
     meta = {"grid": name, "nominal_hz": 50.0, "step_s": 1.0, "start_unix_s": float(START),
             "count": count, "encoding": "i32 little-endian, µHz deviation from nominal_hz, "
@@ -158,8 +181,11 @@ def match(years_list, grids):
             os.makedirs(d, exist_ok=True)
             for n, src in zip(names, dirs):
                 for f in os.listdir(src):
-                    if f.startswith(n + ".") and not os.path.exists(os.path.join(d, f)):
-                        os.link(os.path.join(src, f), os.path.join(d, f))
+                    to = os.path.join(d, f)
+                    if f == n + ".json" and os.path.exists(to):
+                        os.remove(to)  # the manifest may have been given its sums since
+                    if f.startswith(n + ".") and not os.path.exists(to):
+                        os.link(os.path.join(src, f), to)
         at = int(years * 365.25 * 86400 * 0.73)
         for seconds in (300, 3600):
             trace = os.path.join(out, f"cut-{years:g}y-{seconds}.csv")
@@ -193,7 +219,7 @@ def month():
             p["count"] = keep - p["first"]
             with open(path, "r+b") as f:
                 f.truncate(p["count"] * 4)
-            p["crc32"] = zlib.crc32(open(path, "rb").read())
+            p = part_entry(p["file"], p["first"], open(path, "rb").read())
         parts.append(p)
     meta.update(count=keep, parts=parts)
     json.dump(meta, open(manifest, "w"))

@@ -214,8 +214,8 @@ pub struct ReferenceSeries {
 pub enum SeriesValues {
     /// Frequencies, Hz (NaN = gap).
     Hz(Vec<f64>),
-    /// A store's grid, its checksums verified.
-    Stored(GridValues),
+    /// A store's grid, checked (checksums and sums) as it is read.
+    Stored(Box<GridValues>),
 }
 
 impl SeriesValues {
@@ -245,7 +245,7 @@ impl SeriesValues {
     pub fn search(&self, q: &[f64], opts: &MatchOptions) -> Result<MatchResult, MatchError> {
         match self {
             SeriesValues::Hz(v) => match_trace(q, &v[..], opts),
-            SeriesValues::Stored(g) => match_trace(q, g, opts),
+            SeriesValues::Stored(g) => match_trace(q, &**g, opts),
         }
     }
 }
@@ -290,7 +290,7 @@ impl ReferenceSeries {
                     if meta.nominal_hz != nominal {
                         continue; // 50 and 60 Hz are never mixed
                     }
-                    let values = GridValues::open_checked(path, &g)?;
+                    let values = GridValues::open_for_search(path, &g)?;
                     out.push(ReferenceSeries {
                         name: g.clone(),
                         grid: Some(g),
@@ -298,7 +298,7 @@ impl ReferenceSeries {
                         absolute: true,
                         zone: zone.cloned(),
                         step: meta.step_s,
-                        values: SeriesValues::Stored(values),
+                        values: SeriesValues::Stored(Box::new(values)),
                         notes: Vec::new(),
                     });
                 }

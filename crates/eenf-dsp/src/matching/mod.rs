@@ -155,6 +155,20 @@ pub trait ReferenceValues: Sync {
     fn len(&self) -> usize;
     /// Values `start .. start + dst.len()` in Hz, NaN for a gap (the stretch lies inside).
     fn read(&self, start: usize, dst: &mut [f64]) -> Result<(), MatchError>;
+    /// [`Self::read`] for a search, which reads the series a block at a time and calls
+    /// [`Self::end_pass`] once it has read every block: the first `own` values of `dst` are
+    /// this block's own (every value is one block's own). A reader that checks its values
+    /// (a store's checksums) may check them as they pass, once, rather than read them all
+    /// before.
+    fn read_in_pass(&self, start: usize, dst: &mut [f64], own: usize) -> Result<(), MatchError> {
+        let _ = own;
+        self.read(start, dst)
+    }
+    /// Called once every block has been read by [`Self::read_in_pass`], before any answer
+    /// is given: fails when what was read does not check out.
+    fn end_pass(&self) -> Result<(), MatchError> {
+        Ok(())
+    }
     /// True when there is no value.
     fn is_empty(&self) -> bool {
         self.len() == 0
@@ -447,10 +461,7 @@ pub fn match_trace<R: ReferenceValues + ?Sized>(
                     // the maximum and the keys with a score in a loop without branches (a key
                     // without a score is NaN, which no comparison passes); where it beats the
                     // block's best so far, its first place
-                    let (top, finite) =
-                        part.iter().fold((f32::NEG_INFINITY, 0usize), |(a, n), &v| {
-                            (if v > a { v } else { a }, n + usize::from(v.is_finite()))
-                        });
+                    let (top, finite) = crate::simd::fast(|| crate::simd::max_and_finite(part));
                     let top = if top == f32::NEG_INFINITY {
                         f32::NAN
                     } else {
@@ -487,6 +498,8 @@ pub fn match_trace<R: ReferenceValues + ?Sized>(
     }
     let block_best = summaries.iter().map(|s| s.best).collect();
     drop(summaries);
+    // every block read: no answer before the reader's checks of what it read
+    reference.end_pass()?;
 
     let picked = pick_best(block_best, hop, opts.top, opts.exclusion, |bi, picked| {
         let keys = cache.block(bi)?;

@@ -114,6 +114,20 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
         b: &mut Buffers,
         dst: &mut Vec<f32>,
     ) -> Result<(), MatchError> {
+        crate::simd::fast(
+            #[inline(always)]
+            || self.block_keys_inline(bi, b, dst),
+        )
+    }
+
+    /// [`Self::block_keys`], inlined into its builds for each processor.
+    #[inline(always)]
+    fn block_keys_inline(
+        &self,
+        bi: usize,
+        b: &mut Buffers,
+        dst: &mut Vec<f32>,
+    ) -> Result<(), MatchError> {
         let (m, r) = (self.m, self.reference);
         let start = bi * self.hop;
         let count = self.hop.min(self.n_off - start);
@@ -121,7 +135,13 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
         dst.resize(count, f32::NAN);
         // the block's values (NaN for gaps and past the end), then relative to the mean
         let have = (start + self.block).min(r.len()) - start;
-        r.read(start, &mut b.raw[..have])?;
+        // its own values: its offsets' first ones, and the last block's to the end
+        let own = if bi + 1 == self.blocks() {
+            have
+        } else {
+            self.hop
+        };
+        r.read_in_pass(start, &mut b.raw[..have], own)?;
         b.raw[have..].fill(f64::NAN);
         // gaps count as zero in the FFT; their windows are redone below
         let mut finite = true;
@@ -147,42 +167,33 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
             // loop without branches (the formula of the loop below)
             let seg = &b.seg;
             let (sums, sq_sums) = (&mut b.s[..count], &mut b.ss[..count]);
-            // the running sums in four stretches slid side by side (four chains of additions
-            // in flight, not one); each window adds what enters it less what leaves it
-            const LANES: usize = 4;
-            let len = count.div_ceil(LANES);
-            let mut acc = [(0.0f64, 0.0f64); LANES];
-            for (l, a) in acc.iter_mut().enumerate() {
-                let k = l * len;
-                if k < count {
-                    for &v in &seg[k..k + m] {
-                        a.0 += v;
-                        a.1 += v * v;
-                    }
-                    (sums[k], sq_sums[k]) = *a;
-                }
+            // what each window gains over the one before (the value entering it less the one
+            // leaving it), for every offset at once in a loop the compiler vectorises
+            for (((d, dd), &old), &new) in sums[1..]
+                .iter_mut()
+                .zip(&mut sq_sums[1..])
+                .zip(&seg[..count - 1])
+                .zip(&seg[m..m + count - 1])
+            {
+                *d = new - old;
+                *dd = new * new - old * old;
             }
-            let step = |a: &mut (f64, f64), j: usize, sums: &mut [f64], sq_sums: &mut [f64]| {
-                let (old, new) = (seg[j - 1], seg[j + m - 1]);
-                a.0 += new - old;
-                a.1 += new * new - old * old;
-                (sums[j], sq_sums[j]) = *a;
-            };
-            // lanes are `len` long but the last ones, which may be shorter: up to the last
-            // lane's length, every lane steps
-            let full = count.saturating_sub((LANES - 1) * len);
-            for k in 1..full {
-                for (l, a) in acc.iter_mut().enumerate() {
-                    step(a, l * len + k, sums, sq_sums);
+            // then the sums: four stretches, each from its first window's sum in full
+            let len = count.div_ceil(4);
+            let mut lanes: [&mut [f64]; 4] = Default::default();
+            let mut sq_lanes: [&mut [f64]; 4] = Default::default();
+            let stretches = sums.chunks_mut(len).zip(sq_sums.chunks_mut(len));
+            for (l, (s, ss)) in stretches.enumerate() {
+                let (mut a, mut aa) = (0.0, 0.0);
+                for &v in &seg[l * len..l * len + m] {
+                    a += v;
+                    aa += v * v;
                 }
+                (s[0], ss[0]) = (a, aa);
+                (lanes[l], sq_lanes[l]) = (s, ss);
             }
-            for k in full.max(1)..len {
-                for (l, a) in acc.iter_mut().enumerate() {
-                    if l * len + k < count {
-                        step(a, l * len + k, sums, sq_sums);
-                    }
-                }
-            }
+            accumulate(lanes);
+            accumulate(sq_lanes);
             formula.keys(self.score, &b.buf[..count], sums, sq_sums, dst);
             return Ok(());
         }
@@ -231,6 +242,36 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
     }
 }
 
+/// Turns each of four stretches of gains into running sums from its first value, the four
+/// slid side by side: four chains of additions in flight, not one.
+#[inline(always)]
+fn accumulate(lanes: [&mut [f64]; 4]) {
+    let full = lanes.iter().map(|l| l.len()).min().unwrap_or(0);
+    let [a, b, c, d] = lanes;
+    if full > 1 {
+        let (mut sa, mut sb, mut sc, mut sd) = (a[0], b[0], c[0], d[0]);
+        let (a1, b1, c1, d1) = (
+            &mut a[1..full],
+            &mut b[1..full],
+            &mut c[1..full],
+            &mut d[1..full],
+        );
+        for (((xa, xb), xc), xd) in a1.iter_mut().zip(b1).zip(c1).zip(d1) {
+            sa += *xa;
+            sb += *xb;
+            sc += *xc;
+            sd += *xd;
+            (*xa, *xb, *xc, *xd) = (sa, sb, sc, sd);
+        }
+    }
+    // the longer stretches' ends
+    for l in [a, b, c, d] {
+        for k in full.max(1)..l.len() {
+            l[k] += l[k - 1];
+        }
+    }
+}
+
 /// The key of a window without gaps from its cross-correlation `x` with the trace and its
 /// sums `s` = Σr, `ss` = Σr²: [`rank_key`]'s value, in one square root and one division.
 struct KeyFormula {
@@ -274,6 +315,7 @@ impl KeyFormula {
 
     /// The keys of a block without gaps into `dst`, in a loop without branches that the
     /// compiler vectorises (each operation correctly rounded: the numbers of [`Self::key`]).
+    #[inline(always)]
     fn keys(&self, score: Score, xc: &[f64], s: &[f64], ss: &[f64], dst: &mut [f32]) {
         match score {
             Score::Combined => self.keys_of::<true>(xc, s, ss, dst),

@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use eenf_core::Grid;
 
 use super::values::{decode, read_bytes, read_part, GridValues};
-use super::{crc_of, manifest, part_path, to_stored, Part, RefMeta, StoredGrid, GAP, PART_VALUES};
+use super::{
+    crc_of, finite_sum, manifest, part_path, to_stored, Part, RefMeta, StoredGrid, GAP, PART_VALUES,
+};
 use crate::error::{fail, Context, Result};
 use crate::output::write_atomic;
 
@@ -233,11 +235,14 @@ impl GridEdit {
         File::open(&path)
             .and_then(|f| f.sync_all())
             .with_context(|| format!("{}", path.display()))?;
+        let (finite, sum) = finite_sum(values.iter().copied());
         let part = Part {
             file,
             first,
             count: values.len(),
             crc32: Some(crc_of(&bytes)),
+            finite: Some(finite),
+            sum_uhz: Some(sum),
         };
         let k = self.parts.partition_point(|p| p.first < first);
         self.parts.insert(k, part);

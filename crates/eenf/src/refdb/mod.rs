@@ -135,6 +135,14 @@ pub struct Part {
     /// CRC-32 (IEEE) of its bytes; absent in stores written before checksums.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crc32: Option<u32>,
+    /// Its values that are not gaps, and `sum_uhz` their sum (stored units): the grid's mean
+    /// without reading it, checked as a search reads the values. Absent in stores written
+    /// before them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub finite: Option<usize>,
+    /// See `finite`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sum_uhz: Option<i64>,
 }
 
 /// Values per part: 2^22, 48.5 days at 1 s (16 MB).
@@ -154,6 +162,8 @@ impl RefMeta {
                 first: 0,
                 count: self.count,
                 crc32: self.values_crc32,
+                finite: None,
+                sum_uhz: None,
             }],
         }
     }
@@ -203,6 +213,7 @@ fn to_stored(hz: f64, nominal_hz: f64) -> Option<i32> {
 }
 
 /// A stored value in Hz, NaN for a gap.
+#[inline(always)]
 fn to_hz(v: i32, nominal_hz: f64) -> f64 {
     if v == GAP {
         f64::NAN
@@ -309,6 +320,14 @@ fn part_path(dir: &Path, grid: &str, part: &Part) -> Result<PathBuf> {
         );
     }
     Ok(dir.join(name))
+}
+
+/// How many of `values` are not gaps, and their sum.
+fn finite_sum(values: impl Iterator<Item = i32>) -> (usize, i64) {
+    values.fold((0, 0), |(n, s), v| {
+        let gap = v == GAP;
+        (n + usize::from(!gap), s + if gap { 0 } else { v as i64 })
+    })
 }
 
 /// The CRC-32 of values as the store writes them.

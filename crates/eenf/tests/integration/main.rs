@@ -22,5 +22,6 @@ mod unit_grid;
 mod unit_output;
 mod unit_progress;
 mod unit_refdb;
+mod unit_refdb_search;
 mod unit_time;
 mod unit_trace;
