@@ -184,13 +184,13 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
             let mut sq_lanes: [&mut [f64]; 4] = Default::default();
             let stretches = sums.chunks_mut(len).zip(sq_sums.chunks_mut(len));
             for (l, (s, ss)) in stretches.enumerate() {
-                let (mut a, mut aa) = (0.0, 0.0);
-                for &v in &seg[l * len..l * len + m] {
-                    a += v;
-                    aa += v * v;
-                }
-                (s[0], ss[0]) = (a, aa);
                 (lanes[l], sq_lanes[l]) = (s, ss);
+            }
+            let firsts = window_sums(seg, m, len, lanes.iter().filter(|l| !l.is_empty()).count());
+            for (l, (a, aa)) in firsts.into_iter().enumerate() {
+                if let (Some(s), Some(ss)) = (lanes[l].first_mut(), sq_lanes[l].first_mut()) {
+                    (*s, *ss) = (a, aa);
+                }
             }
             accumulate(lanes);
             accumulate(sq_lanes);
@@ -240,6 +240,31 @@ impl<'a, R: ReferenceValues + ?Sized> Scorer<'a, R> {
         }
         Ok(())
     }
+}
+
+/// Σv and Σv² over the windows of `m` values starting at 0, `len`, 2·`len` and 3·`len` of
+/// `seg` (the first `lanes` of them; the others 0), each summed in order, the four side by
+/// side (eight chains of additions in flight, not two: an hour-long trace's windows are long).
+#[inline(always)]
+fn window_sums(seg: &[f64], m: usize, len: usize, lanes: usize) -> [(f64, f64); 4] {
+    let mut out = [(0.0, 0.0); 4];
+    if lanes == 4 {
+        let [a, b, c, d] = [0, 1, 2, 3].map(|l| &seg[l * len..l * len + m]);
+        for (((&va, &vb), &vc), &vd) in a.iter().zip(b).zip(c).zip(d) {
+            for (o, v) in out.iter_mut().zip([va, vb, vc, vd]) {
+                o.0 += v;
+                o.1 += v * v;
+            }
+        }
+        return out;
+    }
+    for (l, o) in out.iter_mut().enumerate().take(lanes) {
+        for &v in &seg[l * len..l * len + m] {
+            o.0 += v;
+            o.1 += v * v;
+        }
+    }
+    out
 }
 
 /// Turns each of four stretches of gains into running sums from its first value, the four

@@ -323,6 +323,7 @@ fn part_path(dir: &Path, grid: &str, part: &Part) -> Result<PathBuf> {
 }
 
 /// How many of `values` are not gaps, and their sum.
+#[inline(always)]
 fn finite_sum(values: impl Iterator<Item = i32>) -> (usize, i64) {
     values.fold((0, 0), |(n, s), v| {
         let gap = v == GAP;

@@ -415,12 +415,10 @@ impl GridValues {
                 let owned = own.map_or(0, |n| (start + n).min(hi).saturating_sub(lo));
                 if owned > 0 {
                     let mine = &raw[..owned * 4];
-                    let (finite, sum) = super::finite_sum(
-                        mine.as_chunks::<4>()
-                            .0
-                            .iter()
-                            .map(|c| i32::from_le_bytes(*c)),
-                    );
+                    let (finite, sum) = eenf_dsp::simd::fast(|| {
+                        let values = mine.as_chunks::<4>().0.iter();
+                        super::finite_sum(values.map(|c| i32::from_le_bytes(*c)))
+                    });
                     let piece = Piece {
                         part: k,
                         at,
