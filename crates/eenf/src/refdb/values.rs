@@ -109,6 +109,15 @@ fn check_part(part: &Part, path: &Path, crc32: u32, finite: usize, sum: i128) ->
     Ok(())
 }
 
+/// How many of the stored values in `bytes` are not gaps, and their sum, in one loop built
+/// for the processor.
+fn stretch_sums(bytes: &[u8]) -> (usize, i64) {
+    eenf_dsp::simd::fast(|| {
+        let values = bytes.as_chunks::<4>().0.iter();
+        super::finite_sum(values.map(|c| i32::from_le_bytes(*c)))
+    })
+}
+
 /// Reads a part file's bytes from value `at` into `bytes`.
 pub(super) fn read_bytes(file: &File, at: usize, bytes: &mut [u8]) -> std::io::Result<()> {
     let offset = at as u64 * 4;
@@ -210,16 +219,9 @@ impl GridValues {
                     let raw = &mut bytes[..STRETCH.min(part.count - lo) * 4];
                     read_bytes(file, lo, raw).with_context(|| format!("{}", path.display()))?;
                     h.update(raw);
-                    // gaps and the sum of the rest in one loop the compiler vectorises
-                    let (mut gaps, mut sum) = (0usize, 0i64);
-                    for c in raw.chunks_exact(4) {
-                        let v = i32::from_le_bytes([c[0], c[1], c[2], c[3]]);
-                        let gap = v == GAP;
-                        gaps += usize::from(gap);
-                        sum += if gap { 0 } else { v as i64 };
-                    }
-                    let n = raw.len() / 4;
-                    s.finite += n - gaps;
+                    let (finite, sum) = stretch_sums(raw);
+                    let gaps = raw.len() / 4 - finite;
+                    s.finite += finite;
                     s.sum += sum as i128;
                     if gaps == 0 {
                         if lo == 0 {
@@ -415,10 +417,7 @@ impl GridValues {
                 let owned = own.map_or(0, |n| (start + n).min(hi).saturating_sub(lo));
                 if owned > 0 {
                     let mine = &raw[..owned * 4];
-                    let (finite, sum) = eenf_dsp::simd::fast(|| {
-                        let values = mine.as_chunks::<4>().0.iter();
-                        super::finite_sum(values.map(|c| i32::from_le_bytes(*c)))
-                    });
+                    let (finite, sum) = stretch_sums(mine);
                     let piece = Piece {
                         part: k,
                         at,
